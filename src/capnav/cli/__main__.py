@@ -1,0 +1,3 @@
+from capnav.cli import main
+
+main()

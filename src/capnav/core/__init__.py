@@ -1,0 +1,1 @@
+"""Conventions shared by every stage: frames, poses, grids, categories, errors, registries."""

@@ -1,0 +1,90 @@
+"""The scene manifest: the simulator's ground truth, for the simulator detector and evaluation only.
+
+The mapping, captioning and retrieval pipeline never reads it. Versioned; saved as
+``manifest.json`` beside a generated scene / dataset. See docs/formats.md.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from pydantic import BaseModel, Field, ValidationError
+
+from capnav.core.atomic import write_text
+from capnav.core.errors import DatasetError
+
+MANIFEST_VERSION = 1
+
+Vec2 = tuple[float, float]
+Vec3 = tuple[float, float, float]
+
+
+class ObjectInstance(BaseModel):
+    """One physical object. ``id`` equals the instance id in the rendered ``gt_instance`` images."""
+
+    id: int = Field(ge=1)
+    category: str
+    category_id: int = Field(ge=1)
+    color_name: str
+    color_rgb: tuple[int, int, int]
+    material: str
+    shape: str = Field(description="shape variant, e.g. 'curved', 'round', 'l-shaped'")
+    size: Vec3 = Field(description="extent (m) along the object's local x, y, z axes")
+    center: Vec3 = Field(description="centre of the oriented box in the world (m)")
+    yaw: float = Field(description="rotation about world z (rad) of the local x axis")
+    footprint: list[Vec2] = Field(description="4 world (x, y) corners of the 2D footprint, counter-clockwise")
+    room: str = Field(description="id of the room containing the centre")
+    model: str = Field(description="'primitive:<name>' or 'sh3d:<catalog id>'")
+    license: str = "CC0-1.0"
+
+
+class Room(BaseModel):
+    id: str
+    name: str = Field(description="room type: living room, kitchen, bedroom, bathroom, office, hallway")
+    polygon: list[Vec2]
+
+
+class Door(BaseModel):
+    rooms: tuple[str, str]
+    center: Vec2
+    width: float
+
+
+class SceneManifest(BaseModel):
+    version: int = MANIFEST_VERSION
+    seed: int
+    generator: str = "capnav.sim.apartment"
+    bounds: tuple[float, float, float, float] = Field(description="xmin, ymin, xmax, ymax of the walls (m)")
+    wall_height: float
+    rooms: list[Room]
+    doors: list[Door] = []
+    objects: list[ObjectInstance]
+
+    def object(self, instance_id: int) -> ObjectInstance:
+        for o in self.objects:
+            if o.id == instance_id:
+                return o
+        raise KeyError(f"no instance {instance_id} in scene seed {self.seed}")
+
+    def by_category(self, name: str) -> list[ObjectInstance]:
+        return [o for o in self.objects if o.category == name]
+
+    def save(self, path: str | Path) -> None:
+        write_text(path, self.model_dump_json(indent=2) + "\n")
+
+    @classmethod
+    def load(cls, path: str | Path) -> SceneManifest:
+        p = Path(path)
+        try:
+            data = json.loads(p.read_text())
+        except FileNotFoundError:
+            raise DatasetError(f"manifest not found: {p}") from None
+        except json.JSONDecodeError as e:
+            raise DatasetError(f"manifest {p} is not valid JSON: {e}") from None
+        if data.get("version") != MANIFEST_VERSION:
+            raise DatasetError(f"manifest {p} has version {data.get('version')}, expected {MANIFEST_VERSION}")
+        try:
+            return cls.model_validate(data)
+        except ValidationError as e:
+            raise DatasetError(f"manifest {p} is malformed: {e}") from None
