@@ -90,7 +90,7 @@ class OccupancyGrid:
         if r > 0 and occ.any():
             # Distance transform gives an exact disk without building a structuring element.
             dist = ndimage.distance_transform_edt(~occ) * self.spec.resolution
-            occ = dist <= radius
+            occ = dist <= radius + 1e-9  # tolerate float round-off at exact multiples of the cell size
         cells = self.cells.copy()
         cells[occ] = OCCUPIED
         return OccupancyGrid(self.spec, cells)
