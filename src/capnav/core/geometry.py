@@ -59,13 +59,13 @@ class Intrinsics:
         return {"fx": self.fx, "fy": self.fy, "cx": self.cx, "cy": self.cy, "width": self.width, "height": self.height}
 
 
-def check_pose(T: FloatArray, frame: int | str = "?", tol: float = 1e-4) -> NDArray[np.float64]:
+def check_pose(T_in: FloatArray, frame: int | str = "?", tol: float = 1e-3) -> NDArray[np.float64]:
     """Return ``T`` as float64 4x4 if it is a rigid transform, else raise ``PoseError`` naming ``frame``.
 
     Rigid means: finite, last row [0 0 0 1], rotation orthonormal with det +1. Wrong pose
     conventions are the most reported failure in peer projects, so every loader calls this.
     """
-    T = np.asarray(T, dtype=np.float64)
+    T: NDArray[np.float64] = np.asarray(T_in, dtype=np.float64)
     if T.shape != (4, 4):
         raise PoseError(frame, f"pose must be 4x4, got shape {T.shape}")
     if not np.all(np.isfinite(T)):
@@ -74,7 +74,7 @@ def check_pose(T: FloatArray, frame: int | str = "?", tol: float = 1e-4) -> NDAr
         raise PoseError(frame, f"pose last row must be [0 0 0 1], got {T[3].tolist()}")
     R = T[:3, :3]
     ortho_err = float(np.abs(R.T @ R - np.eye(3)).max())
-    if ortho_err > 1e3 * tol:
+    if ortho_err > tol:
         raise PoseError(frame, f"rotation is not orthonormal (max |R^T R - I| = {ortho_err:.3g})")
     det = float(np.linalg.det(R))
     if det < 0:
