@@ -1,0 +1,1 @@
+"""Baselines re-implemented in the harness (VLMaps-style, category-only, random-object; exploration baselines in ``explore/``)."""

@@ -1,0 +1,1 @@
+"""Map-based methods: CapNav and its ablations (registered in ``capnav.eval.method.METHODS``)."""
