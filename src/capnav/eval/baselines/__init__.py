@@ -1,1 +1,4 @@
-"""Baselines re-implemented in the harness (VLMaps-style, category-only, random-object; exploration baselines in ``explore/``)."""
+"""Baselines re-implemented in the harness: VLMaps-style, category-only, random-object.
+
+The exploration baselines (CoW-, ZSON-, LM-Nav-style) live in ``explore/``.
+"""
