@@ -1,0 +1,111 @@
+"""The Markdown report: the paper's Table 1 and Table 2 laid out with our numbers beside theirs,
+the description-protocol table the paper lacks, a details table and failure cases."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from capnav.eval.metrics import Summary
+from capnav.eval.paper import PAPER_SETUP, TABLE1, TABLE2
+
+#: Display order of methods in the tables (unknown names follow in the order given).
+ORDER = ("lmnav", "lm-nav", "zson", "cow", "random-object", "category-only", "vlmaps",
+         "capnav-no-verify", "capnav-no-heuristic", "capnav")
+
+
+def _key(name: str) -> str:
+    return name.lower().replace("_", "-")
+
+
+def paper_row(method: str) -> Any:
+    """Paper Table 1 row for one of our method names (``lm-nav`` and ``lmnav`` both match)."""
+    k = _key(method)
+    return TABLE1.get(k) or TABLE1.get(k.replace("-", ""))
+
+
+def _pct(x: float | None) -> str:
+    return "–" if x is None else f"{100.0 * x:.1f}"
+
+
+def _sorted(summaries: Sequence[Summary]) -> list[Summary]:
+    rank = {m: i for i, m in enumerate(ORDER)}
+    return sorted(summaries, key=lambda s: (rank.get(_key(s.method), len(ORDER)), s.method))
+
+
+def table1(summaries: Sequence[Summary], protocol: str = "label") -> list[str]:
+    """In-a-row success for 1..4 subgoals and independent success, paper numbers beside ours."""
+    lines = ["| Method | 1 | 2 | 3 | 4 | Indep. | SPL | Paper 1 / 2 / 3 / 4 | Paper indep. |",
+             "|---|---:|---:|---:|---:|---:|---:|---|---:|"]
+    for s in _sorted([s for s in summaries if s.protocol == protocol]):
+        p = paper_row(s.method)
+        paper = " / ".join(f"{v:g}" for v in p.in_a_row) if p else "–"
+        paper_ind = f"{p.independent:g}" if p else "–"
+        row = " | ".join(_pct(v) for v in s.in_a_row)
+        lines.append(f"| {s.method} | {row} | {_pct(s.independent)} | {_pct(s.spl)} | {paper} | {paper_ind} |")
+    return lines
+
+
+def table2(summaries: Sequence[Summary]) -> list[str]:
+    """Ablations: full-chain success and subgoal success, both protocols, paper beside ours."""
+    by = {(s.method, s.protocol): s for s in summaries}
+    lines = ["| Method | SR (label) | Subgoal SR (label) | SR (description) | Subgoal SR (description) "
+             "| Paper SR | Paper subgoal SR |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for name, (label, psr, psub) in TABLE2.items():
+        lab, des = by.get((name, "label")), by.get((name, "description"))
+        if lab is None and des is None:
+            continue
+        cells = [_pct(s.in_a_row[-1] if s else None) + " | " + _pct(s.independent if s else None) for s in (lab, des)]
+        lines.append(f"| {name} ({label}) | {cells[0]} | {cells[1]} | {psr:g} | {psub:g} |")
+    return lines
+
+
+def details(summaries: Sequence[Summary]) -> list[str]:
+    lines = ["| Method | Protocol | Episodes | Subgoals | Indep. | SPL | Retrieval top-1 | Goal claimed "
+             "| Path / subgoal (m) | Query time mean / p50 (ms) |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for s in _sorted(summaries):
+        lines.append(f"| {s.method} | {s.protocol} | {s.episodes} | {s.subgoals} | {_pct(s.independent)} "
+                     f"| {_pct(s.spl)} | {_pct(s.retrieval_top1)} | {_pct(s.found_rate)} | {s.path_length:.2f} "
+                     f"| {1e3 * s.query_time_mean_s:.1f} / {1e3 * s.query_time_p50_s:.1f} |")
+    return lines
+
+
+def render(summaries: Sequence[Summary], config: Mapping[str, Any],
+           failures: Sequence[Mapping[str, Any]] = (), timings: Mapping[str, float] | None = None) -> str:
+    """The whole report as Markdown. ``failures`` items: method, protocol, episode_id, index, text,
+    reason, distance_to_goal, picture (relative path or empty)."""
+    out = ["# CapNav benchmark report", ""]
+    out.append(f"capnav {config.get('version', '?')} (commit {config.get('commit', '?')}), seed {config.get('seed')}, "
+               f"{config.get('scenes')} apartments (scene seeds {config.get('scene_seeds')}), "
+               f"{config.get('episodes_per_scene')} episodes per apartment and protocol, "
+               f"detector `{config.get('detector', '?')}`, embedder `{config.get('embedder', '?')}`.")
+    out.append("")
+    out.append(f"Command: `{config.get('command', 'capnav eval')}`")
+    out.append("")
+    out.append(f"The paper: {PAPER_SETUP['scenes']} Matterport3D scenes in Habitat, {PAPER_SETUP['episodes']} "
+               f"episodes, {PAPER_SETUP['subgoals']} subgoals, {PAPER_SETUP['categories']} categories, "
+               "Detic + LSeg + Gemini + BGE-M3. Ours: procedural apartments in pybullet, a simulated detector "
+               "with a noise model, offline captions and a MiniLM embedder. Compare methods within a table; "
+               "absolute numbers are not comparable across the two setups.")
+    out += ["", "## Table 1: multi-object navigation, label-only protocol (success %, in a row)", ""]
+    out += table1(summaries, "label")
+    out += ["", "## Table 2: ablations (full-chain success rate and subgoal success rate, %)", ""]
+    out += table2(summaries)
+    out += ["", "## Description protocol: reach the one described instance among lookalikes (%)", "",
+            "Not in the paper (its 'Paper' columns repeat Table 1 for orientation only).", ""]
+    out += table1(summaries, "description")
+    out += ["", "## Details", ""]
+    out += details(summaries)
+    if timings:
+        out += ["", "## Where the time went (s, summed over workers)", "",
+                "| Stage | Seconds |", "|---|---:|"]
+        out += [f"| {k} | {v:.1f} |" for k, v in timings.items()]
+    if failures:
+        out += ["", "## Failure cases", ""]
+        for f in failures:
+            pic = f" ![]({f['picture']})" if f.get("picture") else ""
+            out.append(f"- **{f['method']}** / {f['protocol']} / {f['episode_id']} #{f['index']}: "
+                       f"\"{f['text']}\" stopped {f['distance_to_goal']:.2f} m from the goal; {f['reason']}{pic}")
+    return "\n".join(out) + "\n"
