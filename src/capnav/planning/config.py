@@ -1,0 +1,45 @@
+"""Planner settings in one place, with the values used by the paper's evaluation as defaults."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from capnav.core.errors import InputError
+
+
+@dataclass(frozen=True)
+class PlannerConfig:
+    """How goals are chosen, how A* weighs the map and how the agent executes a path.
+
+    ``reach`` is the paper's 1 m success radius around the goal instance. Goal selection aims a
+    little inside it (``goal_margin``) so a slightly wrong mapped footprint still counts as reached.
+    """
+
+    robot_radius: float = 0.18  # m, the agent's base radius (sim agent)
+    safety_margin: float = 0.05  # m, added to the radius when obstacles are inflated
+    reach: float = 1.0  # m, success radius around the object's footprint
+    goal_margin: float = 0.3  # m, aim at cells within reach - goal_margin when possible
+    unknown_cost: float | None = 3.0  # weight of an unknown cell; None = unknown is blocked
+    backend: str = "numba"  # grid search backend (see capnav.planning.backends.BACKENDS)
+    simplify: bool = True  # line-of-sight simplification of the cell path into waypoints
+    escape_radius: float = 0.5  # m, a start inside the inflation band snaps to a free cell this close
+    max_replans: int = 12  # collisions tolerated during execution before giving up
+    blocked_mark_radius: float = 0.08  # m, obstacle disk stamped ahead of the agent on a collision
+    max_steps: int = 2000  # discrete-action budget when the agent has no move_to
+
+    def __post_init__(self) -> None:
+        for name in ("robot_radius", "safety_margin", "goal_margin", "escape_radius", "blocked_mark_radius"):
+            v = getattr(self, name)
+            if not v >= 0.0:
+                raise InputError(f"PlannerConfig.{name} must be >= 0, got {v}")
+        if not self.reach > 0.0:
+            raise InputError(f"PlannerConfig.reach must be > 0, got {self.reach}")
+        if self.unknown_cost is not None and not self.unknown_cost >= 1.0:
+            raise InputError(f"PlannerConfig.unknown_cost must be >= 1 or None (blocked), got {self.unknown_cost}")
+        if self.max_replans < 0 or self.max_steps < 1:
+            raise InputError("PlannerConfig.max_replans must be >= 0 and max_steps >= 1")
+
+    @property
+    def inflation(self) -> float:
+        """Distance (m) by which obstacles are grown before planning."""
+        return self.robot_radius + self.safety_margin

@@ -1,0 +1,223 @@
+"""Execution: drive a simulator (or robot) agent along the planned path to the goal.
+
+The agent follows the waypoints with ``move_to`` (straight segments, stops at contact) or, when it
+only has discrete actions, with turn / forward steps. A contact means the map missed an obstacle:
+the cells ahead of the agent are marked blocked, and goal and path are chosen again from where the
+agent stands, up to ``max_replans`` times.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from capnav.core.errors import CapNavError
+from capnav.core.grid import OccupancyGrid
+from capnav.eval.success import footprint_distance
+from capnav.planning.config import PlannerConfig
+from capnav.planning.costmap import Costmap, build_costmap, mark_blocked
+from capnav.planning.goal import GoalPose, check_footprint, select_goal
+from capnav.planning.path import PlannedPath, plan_path
+
+
+@runtime_checkable
+class StepAgent(Protocol):
+    """The least an agent offers: a pose ``(x, y, yaw)`` and discrete actions."""
+
+    @property
+    def pose(self) -> tuple[float, float, float]: ...
+
+    def step(self, action: str) -> bool: ...
+
+
+@dataclass
+class NavResult:
+    """The outcome of one navigation: whether the agent stopped within reach of the (mapped)
+    footprint, where, how far it drove, how often it replanned, and why it stopped."""
+
+    reached: bool
+    final_pose: tuple[float, float, float]
+    path_length: float
+    replans: int
+    waypoints: NDArray[np.float64]  # (M, 2) of the last plan
+    reason: str
+    goal: GoalPose | None = None
+    distance_to_object: float = float("inf")
+    trajectory: NDArray[np.float64] = field(default_factory=lambda: np.empty((0, 2)))  # (T, 2) executed x, y
+    plans: list[PlannedPath] = field(default_factory=list)
+    events: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "reached": self.reached,
+            "final_pose": [round(float(v), 4) for v in self.final_pose],
+            "path_length": round(self.path_length, 4),
+            "replans": self.replans,
+            "distance_to_object": round(self.distance_to_object, 4),
+            "reason": self.reason,
+            "goal": self.goal.to_dict() if self.goal else None,
+            "waypoints": np.round(self.waypoints, 4).tolist(),
+            "trajectory": np.round(self.trajectory, 4).tolist(),
+            "plans": [p.to_dict() for p in self.plans],
+            "events": list(self.events),
+        }
+
+
+def navigate_to(agent: StepAgent, occ: OccupancyGrid, target_footprint: NDArray[np.floating],
+                config: PlannerConfig | None = None, costmap: Costmap | None = None) -> NavResult:
+    """Select a goal near ``target_footprint``, plan with A*, and drive ``agent`` there.
+
+    Bad input (map, footprint, a start inside an obstacle) raises; failing to get there (goal
+    unreachable, too many collisions) returns ``reached=False`` with the reason.
+    """
+    cfg = config or PlannerConfig()
+    fp = check_footprint(target_footprint)
+    cm = build_costmap(occ, cfg) if costmap is None else Costmap(
+        OccupancyGrid(costmap.spec, costmap.occ.cells.copy()), costmap.weights.copy())
+    log = _Log(agent, cfg.max_steps)
+    goal: GoalPose | None = None
+    plans: list[PlannedPath] = []
+    events: list[str] = []
+    replans = 0
+    reason = ""
+    first = True
+    while True:
+        here = log.xy()
+        try:
+            goal = select_goal(cm.occ, fp, here, cfg, cm)
+            plan = plan_path(cm.occ, here, goal.xy, cfg, cm)
+        except CapNavError as e:
+            if first:
+                raise
+            reason = f"replanning failed after {replans} collision(s): {e}"
+            break
+        first = False
+        plans.append(plan)
+        events.extend(plan.notes)
+        blocked_at = _follow(agent, plan.waypoints, cfg, log)
+        if blocked_at is None:
+            _face(agent, goal.yaw, log)
+            reason = goal.reason
+            break
+        n = mark_blocked(cm, blocked_at, cfg.blocked_mark_radius, cfg)
+        replans += 1
+        events.append(f"contact near ({blocked_at[0]:.2f}, {blocked_at[1]:.2f}); {n} cells blocked; replanning")
+        if replans > cfg.max_replans:
+            reason = f"gave up after {cfg.max_replans} replans (the map keeps disagreeing with the world)"
+            break
+    pose = tuple(float(v) for v in agent.pose)
+    dist = float(footprint_distance(np.asarray(pose[:2]).reshape(1, 2), fp)[0])
+    reached = dist <= cfg.reach
+    if not reached and reason == (goal.reason if goal else ""):
+        reason = f"stopped {dist:.2f} m from the object (reach {cfg.reach:.2f} m): {reason}"
+    return NavResult(reached, (pose[0], pose[1], pose[2]), log.length, replans,
+                     plans[-1].waypoints if plans else np.empty((0, 2)), reason, goal, dist, log.array(), plans,
+                     events)
+
+
+class _Log:
+    """The executed trajectory and its length, recorded from the agent's pose after every motion."""
+
+    def __init__(self, agent: StepAgent, max_steps: int) -> None:
+        self.agent = agent
+        self.budget = [max_steps]  # discrete actions left (shared by driving and turning)
+        self.points: list[tuple[float, float]] = [self.xy()]
+        self.length = 0.0
+
+    def xy(self) -> tuple[float, float]:
+        p = self.agent.pose
+        return float(p[0]), float(p[1])
+
+    def record(self, trace: list[tuple[float, float]] | None = None) -> None:
+        for q in [*(trace or []), self.xy()]:
+            last = self.points[-1]
+            d = math.hypot(q[0] - last[0], q[1] - last[1])
+            if d > 1e-9:
+                self.points.append(q)
+                self.length += d
+
+    def array(self) -> NDArray[np.float64]:
+        return np.asarray(self.points, dtype=np.float64)
+
+
+def _follow(agent: StepAgent, waypoints: NDArray[np.float64], cfg: PlannerConfig, log: _Log
+            ) -> NDArray[np.float64] | None:
+    """Drive through the waypoints; return the contact point ahead of the agent when blocked."""
+    move_to = getattr(agent, "move_to", None)
+    for wp in waypoints[1:]:
+        if move_to is not None:
+            before = len(_trajectory(agent))
+            ok = bool(move_to(float(wp[0]), float(wp[1])))
+            log.record(_trajectory(agent)[before:])
+        else:
+            ok = _drive_discrete(agent, wp, cfg, log)
+        if not ok:
+            return _contact_point(agent, wp, cfg)
+    return None
+
+
+def _trajectory(agent: object) -> list[tuple[float, float]]:
+    traj = getattr(agent, "trajectory", None)
+    if traj is None:
+        return []
+    return [(float(p[0]), float(p[1])) for p in traj]
+
+
+def _contact_point(agent: StepAgent, target: NDArray[np.float64], cfg: PlannerConfig) -> NDArray[np.float64]:
+    """Where the unseen obstacle is: just beyond the agent's rim, towards where it was going."""
+    x, y, yaw = (float(v) for v in agent.pose)
+    d = np.asarray(target, dtype=np.float64) - (x, y)
+    n = float(np.hypot(*d))
+    u = d / n if n > 1e-6 else np.array([math.cos(yaw), math.sin(yaw)])
+    return np.array([x, y]) + u * (cfg.robot_radius + cfg.blocked_mark_radius)
+
+
+def _motion(agent: object) -> tuple[float, float]:
+    """The agent's forward step (m) and turn angle (rad), from its config when it has one."""
+    ac = getattr(agent, "config", None)
+    step = float(getattr(ac, "forward_step", 0.25))
+    turn = math.radians(float(getattr(ac, "turn_deg", 30.0)))
+    return step, turn
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+def _turn_towards(agent: StepAgent, yaw: float, turn: float, log: _Log, budget: list[int]) -> None:
+    while budget[0] > 0:
+        err = _wrap(yaw - float(agent.pose[2]))
+        if abs(err) <= turn / 2:
+            return
+        agent.step("turn_left" if err > 0 else "turn_right")
+        budget[0] -= 1
+        log.record()
+
+
+def _drive_discrete(agent: StepAgent, target: NDArray[np.float64], cfg: PlannerConfig, log: _Log) -> bool:
+    step, turn = _motion(agent)
+    budget = log.budget
+    while budget[0] > 0:
+        x, y, _ = agent.pose
+        dx, dy = float(target[0]) - x, float(target[1]) - y
+        dist = math.hypot(dx, dy)
+        if dist <= step / 2:
+            return True
+        _turn_towards(agent, math.atan2(dy, dx), turn, log, budget)
+        ok = agent.step("move_forward")
+        budget[0] -= 1
+        log.record()
+        if not ok:
+            return False
+    return True
+
+
+def _face(agent: StepAgent, yaw: float, log: _Log) -> None:
+    """Turn in place to face the object when the agent has turn actions."""
+    if callable(getattr(agent, "step", None)):
+        _, turn = _motion(agent)
+        _turn_towards(agent, yaw, turn, log, [math.ceil(math.pi / turn) + 1])

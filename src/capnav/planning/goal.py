@@ -1,0 +1,106 @@
+"""Goal selection (Sec. 3.4): the chosen object's footprint becomes a reachable metric waypoint.
+
+The paper turns the object's cell into a waypoint; an object's own cell is an obstacle, so we pick
+the free cell nearest to the robot (by path cost) among those within the reach radius of the
+footprint, aiming ``goal_margin`` inside it when possible, and face the object from there.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from capnav.core.errors import InputError, NotFoundError
+from capnav.core.grid import OccupancyGrid
+from capnav.eval.success import footprint_distance
+from capnav.planning.config import PlannerConfig
+from capnav.planning.costmap import Costmap, build_costmap, locate_start
+from capnav.planning.search import cost_field
+
+
+@dataclass(frozen=True)
+class GoalPose:
+    """Where to stop: ``xy`` world, ``yaw`` facing the object, its grid ``cell``; whether it lies
+    within ``reach`` of the footprint, why it was chosen, and its distance / path cost (m)."""
+
+    xy: NDArray[np.float64]
+    yaw: float
+    cell: tuple[int, int]
+    reached_within_reach: bool
+    reason: str
+    distance_to_object: float
+    path_cost: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"xy": [round(float(v), 4) for v in self.xy], "yaw": round(self.yaw, 4), "cell": list(self.cell),
+                "reached_within_reach": self.reached_within_reach, "reason": self.reason,
+                "distance_to_object": round(self.distance_to_object, 4), "path_cost": round(self.path_cost, 4)}
+
+
+def check_footprint(footprint: object) -> NDArray[np.float64]:
+    fp = np.asarray(footprint, dtype=np.float64)
+    if fp.ndim != 2 or fp.shape[1] != 2 or len(fp) == 0:
+        raise InputError(f"target footprint must be a (K, 2) array of world x, y, got shape {fp.shape}")
+    if not np.isfinite(fp).all():
+        raise InputError("target footprint has non-finite coordinates")
+    return fp
+
+
+def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], start_xy: Any,
+                config: PlannerConfig | None = None, costmap: Costmap | None = None) -> GoalPose:
+    """Nearest reachable free cell within ``config.reach`` of the footprint (preferring
+    ``reach - goal_margin``); else the reachable cell closest to the object, with the reason.
+
+    Raises ``NotFoundError`` when nothing at all is reachable from the start.
+    """
+    cfg = config or PlannerConfig()
+    fp = check_footprint(target_footprint)
+    cm = costmap if costmap is not None else build_costmap(occ, cfg)
+    spec = cm.spec
+    s_cell, _ = locate_start(cm, start_xy, cfg)
+    field, _ = cost_field(cm.weights, s_cell)
+    reach_r, reach_c = np.nonzero(np.isfinite(field))
+    rc = np.stack([reach_r, reach_c], axis=1)
+    centres = spec.to_world(rc)
+    cost = field[reach_r, reach_c] * spec.resolution
+    # Only cells in the footprint's box grown by the reach can be within reach: measure those.
+    lo, hi = fp.min(axis=0) - cfg.reach, fp.max(axis=0) + cfg.reach
+    near = np.nonzero(((centres >= lo) & (centres <= hi)).all(axis=1))[0]
+    dist = np.full(len(rc), np.inf)
+    dist[near] = _distances(centres[near], fp)
+    tiers = ((cfg.reach - cfg.goal_margin, "the nearest reachable free cell {d:.2f} m from the object"),
+             (cfg.reach, "the nearest reachable free cell within reach ({d:.2f} m from the object; none "
+                         f"within {cfg.reach - cfg.goal_margin:.2f} m)"))
+    for limit, why in tiers:
+        ok = np.nonzero(dist <= limit)[0]
+        if ok.size:
+            i = int(ok[np.argmin(cost[ok])])
+            return _pose(rc[i], centres[i], fp, True, why.format(d=dist[i]), float(dist[i]), float(cost[i]))
+    if len(rc) == 0:  # pragma: no cover - the start cell itself is always reachable
+        raise NotFoundError("no cell is reachable from the start")
+    dist = _distances(centres, fp)
+    best = dist.min()
+    ok = np.nonzero(dist <= best + 0.5 * spec.resolution)[0]
+    i = int(ok[np.argmin(cost[ok])])
+    why = (f"no reachable free cell within {cfg.reach:.2f} m of the object; closest reachable cell is "
+           f"{dist[i]:.2f} m away")
+    return _pose(rc[i], centres[i], fp, False, why, float(dist[i]), float(cost[i]))
+
+
+def _distances(points: NDArray[np.float64], fp: NDArray[np.float64], chunk: int = 65536) -> NDArray[np.float64]:
+    """Footprint distance in chunks so a large map never builds a huge (N, K, 2) temporary."""
+    out = np.empty(len(points), np.float64)
+    for a in range(0, len(points), chunk):
+        out[a:a + chunk] = footprint_distance(points[a:a + chunk], fp)
+    return out
+
+
+def _pose(cell: NDArray[np.intp], xy: NDArray[np.float64], fp: NDArray[np.float64], within: bool, reason: str,
+          dist: float, cost: float) -> GoalPose:
+    centre = fp.mean(axis=0)
+    d = centre - xy
+    yaw = float(np.arctan2(d[1], d[0])) if np.hypot(*d) > 1e-9 else 0.0
+    return GoalPose(np.asarray(xy, dtype=np.float64), yaw, (int(cell[0]), int(cell[1])), within, reason, dist, cost)
