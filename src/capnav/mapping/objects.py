@@ -61,6 +61,8 @@ class MapObject:
     caption_source: str | None = None  # backend id, or "fallback: <reason>"
     embedding: NDArray[np.float32] | None = None  # (E,) L2-normalised (eq. 14)
     embedding_model: str | None = None
+    category_id: int = 0  # vocabulary id of ``label`` (0 = outside the vocabulary)
+    track_ids: list[int] = field(default_factory=list)  # SG3DTracker tracks fused into this object
 
     @property
     def size(self) -> NDArray[np.float64]:

@@ -1,1 +1,35 @@
-"""perception stage."""
+"""Perception stage: detectors (eq. 9) and dense feature encoders (LSeg's Phi_t), chosen by name."""
+
+from capnav.perception import label_encoder as _label_encoder  # noqa: F401  (registers backends)
+from capnav.perception import sim_detector as _sim_detector  # noqa: F401
+from capnav.perception.base import (
+    DETECTORS,
+    ENCODERS,
+    DenseFeatureEncoder,
+    Detection,
+    Detector,
+    TextEmbedderLike,
+    box_from_mask,
+    create_detector,
+    create_encoder,
+    validate_detections,
+)
+from capnav.perception.label_encoder import LabelEmbeddingEncoder
+from capnav.perception.sim_detector import NOISE_PRESETS, SimDetector, SimNoise
+
+__all__ = [
+    "DETECTORS",
+    "ENCODERS",
+    "NOISE_PRESETS",
+    "DenseFeatureEncoder",
+    "Detection",
+    "Detector",
+    "LabelEmbeddingEncoder",
+    "SimDetector",
+    "SimNoise",
+    "TextEmbedderLike",
+    "box_from_mask",
+    "create_detector",
+    "create_encoder",
+    "validate_detections",
+]

@@ -1,0 +1,99 @@
+"""Numba kernels of the sparse voxel map: an open-addressing hash from voxel key to slot, and the
+per-point running weighted averages of eq. 6-8 (numpy has no vectorised "update this slot in
+place, in order" primitive; a sort-and-reduce per frame is 5-10x slower)."""
+
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+from numpy.typing import NDArray
+
+EMPTY = np.int64(-1)
+OFFSET = 1 << 20  # voxel indices in [-2^20, 2^20) (52 km at 5 cm) are packed into 21 bits each
+_MULT = np.uint64(0x9E3779B97F4A7C15)
+
+
+def pack_keys(ijk: NDArray[np.integer]) -> NDArray[np.int64]:
+    """(N, 3) voxel indices -> (N,) non-negative int64 keys."""
+    a = np.asarray(ijk, dtype=np.int64) + OFFSET
+    return (a[:, 0] << 42) | (a[:, 1] << 21) | a[:, 2]
+
+
+def unpack_keys(keys: NDArray[np.int64]) -> NDArray[np.int32]:
+    mask = (1 << 21) - 1
+    out = np.stack([(keys >> 42) & mask, (keys >> 21) & mask, keys & mask], axis=1) - OFFSET
+    return out.astype(np.int32)
+
+
+@nb.njit(cache=True, nogil=True)
+def _slot_of(table_keys: NDArray[np.int64], key: np.int64, shift: np.uint64) -> np.int64:
+    cap_mask = table_keys.shape[0] - 1
+    h = np.int64((np.uint64(key) * _MULT) >> shift)
+    while True:
+        k = table_keys[h]
+        if k == key or k == -1:
+            return h
+        h = (h + 1) & cap_mask
+
+
+@nb.njit(cache=True, nogil=True)
+def rehash(voxel_keys: NDArray[np.int64], n: int, capacity: int, shift: np.uint64
+           ) -> tuple[NDArray[np.int64], NDArray[np.int32]]:
+    tk = np.full(capacity, -1, dtype=np.int64)
+    tv = np.zeros(capacity, dtype=np.int32)
+    for s in range(n):
+        h = _slot_of(tk, voxel_keys[s], shift)
+        tk[h] = voxel_keys[s]
+        tv[h] = s
+    return tk, tv
+
+
+@nb.njit(cache=True, nogil=True)
+def lookup(table_keys: NDArray[np.int64], table_vals: NDArray[np.int32], keys: NDArray[np.int64],
+           shift: np.uint64) -> NDArray[np.int64]:
+    """Slot of each key, -1 if absent."""
+    out = np.empty(keys.shape[0], dtype=np.int64)
+    for p in range(keys.shape[0]):
+        h = _slot_of(table_keys, keys[p], shift)
+        out[p] = table_vals[h] if table_keys[h] == keys[p] else -1
+    return out
+
+
+@nb.njit(cache=True, nogil=True)
+def fuse(table_keys: NDArray[np.int64], table_vals: NDArray[np.int32], shift: np.uint64,
+         voxel_keys: NDArray[np.int64], weights: NDArray[np.float64], colors: NDArray[np.float32],
+         features: NDArray[np.float32], n: int, keys: NDArray[np.int64], alpha: NDArray[np.float32],
+         point_colors: NDArray[np.uint8], feat_index: NDArray[np.int64], phi: NDArray[np.float32]) -> int:
+    """Apply eq. 6-8 for every point in order; returns the new voxel count.
+
+    Capacity of the table (< 50% load after this call) and of the voxel arrays is ensured by the
+    caller. ``f += a / (w + a) * (f_t - f)`` is eq. 6 rearranged; a new voxel starts at w = 0 so
+    its first value is exactly the first observation (no ``f * alpha`` bias).
+    """
+    d = features.shape[1]
+    for p in range(keys.shape[0]):
+        key = keys[p]
+        h = _slot_of(table_keys, key, shift)
+        if table_keys[h] == -1:
+            table_keys[h] = key
+            table_vals[h] = n
+            s = n
+            voxel_keys[s] = key
+            weights[s] = 0.0
+            for c in range(3):
+                colors[s, c] = 0.0
+            for j in range(d):
+                features[s, j] = 0.0
+            n += 1
+        else:
+            s = table_vals[h]
+        a = np.float64(alpha[p])
+        w_new = weights[s] + a
+        r = np.float32(a / w_new)
+        for c in range(3):
+            colors[s, c] += r * (np.float32(point_colors[p, c]) - colors[s, c])
+        fi = feat_index[p]
+        for j in range(d):
+            features[s, j] += r * (phi[fi, j] - features[s, j])
+        weights[s] = w_new
+    return n

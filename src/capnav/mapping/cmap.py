@@ -1,0 +1,37 @@
+"""``CapNavMap``: everything a map file holds and every later stage reads."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from capnav.core.errors import NotFoundError
+from capnav.core.grid import OccupancyGrid
+from capnav.mapping.objects import MapObject
+from capnav.mapping.voxel_map import VoxelMap
+
+
+@dataclass
+class CapNavMap:
+    """Persistent objects, the semantic voxel map, the top-down occupancy, metadata (JSON-able:
+    frames used and skipped, configuration, dataset path, detector / encoder ids) and ``caches``
+    (JSON-able dicts owned by later stages, e.g. caption and verification caches)."""
+
+    objects: list[MapObject]
+    voxels: VoxelMap
+    occupancy: OccupancyGrid
+    meta: dict[str, Any] = field(default_factory=dict)
+    caches: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+    def object(self, object_id: int) -> MapObject:
+        for o in self.objects:
+            if o.id == object_id:
+                return o
+        raise NotFoundError(f"no object with id {object_id} in the map (ids: {[o.id for o in self.objects]})")
+
+    def by_label(self, label: str) -> list[MapObject]:
+        return [o for o in self.objects if o.label == label]
+
+    def __repr__(self) -> str:
+        return (f"CapNavMap({len(self.objects)} objects, {len(self.voxels)} voxels, "
+                f"occupancy {self.occupancy.spec.rows}x{self.occupancy.spec.cols})")

@@ -1,0 +1,189 @@
+"""The mapping pipeline: frame -> detections + dense features -> voxel fusion (eq. 4-8) and
+lifted detections -> SG3DTracker (Algorithm 1) -> persistent objects -> ``CapNavMap``."""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Iterable
+from dataclasses import asdict, dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from capnav.core.errors import FrameError, InputError
+from capnav.core.frame import Frame
+from capnav.core.geometry import backproject
+from capnav.core.progress import track
+from capnav.mapping.cmap import CapNavMap
+from capnav.mapping.lifting import LiftConfig, LiftedDetection, lift_detection
+from capnav.mapping.memory import MemoryConfig, ObjectMemory
+from capnav.mapping.objects import Observation
+from capnav.mapping.occupancy import OccupancyConfig, occupancy_from_voxels
+from capnav.mapping.tracker import SG3DTracker, TrackerConfig
+from capnav.mapping.voxel_map import VoxelConfig, VoxelMap, radial_weight, random_projection
+from capnav.perception.base import DenseFeatureEncoder, Detector, validate_detections
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class MapperConfig:
+    """All mapping parameters, paper values as defaults where the paper gives them.
+
+    ``on_bad_frame``: "skip" records the frame and the reason in ``meta["frames_skipped"]`` and
+    goes on (one bad frame in 10,000 should not lose a map); "raise" stops with ``FrameError``.
+    Frames with more than ``max_invalid_depth`` invalid depth pixels count as bad.
+    """
+
+    voxel: VoxelConfig = field(default_factory=VoxelConfig)
+    tracker: TrackerConfig = field(default_factory=TrackerConfig)
+    memory: MemoryConfig = field(default_factory=MemoryConfig)
+    occupancy: OccupancyConfig = field(default_factory=OccupancyConfig)
+    lift: LiftConfig = field(default_factory=LiftConfig)
+    on_bad_frame: Literal["skip", "raise"] = "skip"
+    max_invalid_depth: float = 0.98
+
+    def __post_init__(self) -> None:
+        if self.on_bad_frame not in ("skip", "raise"):
+            raise InputError(f"on_bad_frame must be 'skip' or 'raise', got {self.on_bad_frame!r}")
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+class Mapper:
+    """Incremental mapper: ``integrate(frame)`` per frame, ``finish()`` once."""
+
+    def __init__(self, config: MapperConfig | None, detector: Detector, encoder: DenseFeatureEncoder) -> None:
+        self.config = config or MapperConfig()
+        self.detector = detector
+        self.encoder = encoder
+        vc = self.config.voxel
+        d_in = int(encoder.dim)
+        if d_in <= 0:
+            raise InputError(f"encoder {encoder.id} reports feature dim {d_in}")
+        proj = None
+        if vc.feature_dim is not None and vc.feature_dim < d_in:
+            proj = random_projection(d_in, vc.feature_dim, vc.projection_seed)
+        self.voxels = VoxelMap(vc.resolution, vc.origin, proj.shape[1] if proj is not None else d_in, proj,
+                               encoder.text_space)
+        self.tracker = SG3DTracker(self.config.tracker)
+        self.memory = ObjectMemory(self.config.memory)
+        self.frames_used: list[int] = []
+        self.skipped: list[dict[str, Any]] = []
+        self.lift_skips = 0
+        self.seconds = 0.0
+        self._stride_masks: dict[tuple[int, int], NDArray[np.bool_]] = {}
+
+    def _bad(self, err: FrameError) -> bool:
+        if self.config.on_bad_frame == "raise":
+            raise err
+        log.warning("skipping %s", err)
+        self.skipped.append({"frame": err.frame, "reason": err.reason})
+        return False
+
+    def integrate(self, frame: Frame) -> bool:
+        """Fuse one frame; returns False when it was skipped (see ``MapperConfig.on_bad_frame``)."""
+        t0 = time.perf_counter()
+        try:
+            frame.validate(max_invalid_fraction=self.config.max_invalid_depth)
+            dets = validate_detections(frame, self.detector.detect(frame))
+            phi = np.asarray(self.encoder.encode(frame, dets), dtype=np.float32)
+            if phi.ndim != 3 or phi.shape[2] != self.encoder.dim:
+                raise FrameError(frame.index,
+                                 f"encoder returned shape {phi.shape}, expected (H', W', {self.encoder.dim})")
+            if not np.all(np.isfinite(phi)):
+                raise FrameError(frame.index, "encoder returned non-finite features")
+        except FrameError as e:
+            return self._bad(e)
+        self._fuse_voxels(frame, phi)
+        lifted: list[LiftedDetection] = []
+        for k, d in enumerate(dets):
+            ld = lift_detection(frame, d, k, phi, self.config.lift)
+            if ld is None:
+                self.lift_skips += 1
+                continue
+            lifted.append(ld)
+        self._track(frame, lifted)
+        self.frames_used.append(frame.index)
+        self.seconds += time.perf_counter() - t0
+        return True
+
+    def _fuse_voxels(self, frame: Frame, phi: NDArray[np.float32]) -> None:
+        vc = self.config.voxel
+        h, w = frame.shape
+        mask = None
+        if vc.pixel_stride > 1:
+            mask = self._stride_masks.get((h, w))
+            if mask is None:
+                mask = np.zeros((h, w), dtype=bool)
+                mask[:: vc.pixel_stride, :: vc.pixel_stride] = True
+                self._stride_masks[(h, w)] = mask
+        depth = np.where(np.asarray(frame.depth) <= vc.max_depth, frame.depth, 0.0)
+        pc, flat = backproject(depth, frame.K, None, mask)
+        if len(pc) == 0:
+            return
+        T = np.asarray(frame.T_wc, dtype=np.float32)
+        pw = pc @ T[:3, :3].T + T[:3, 3]
+        hh, ww, d = phi.shape
+        v, u = np.divmod(flat, w)
+        fidx = (v * hh // h) * ww + (u * ww // w)
+        table = self.voxels.project(phi.reshape(hh * ww, d)) if self.voxels.projection is not None else phi.reshape(
+            hh * ww, d)
+        colors = np.asarray(frame.rgb).reshape(-1, 3)[flat]
+        self.voxels.integrate(pw, radial_weight(pc, vc.sigma), colors, fidx, table)
+
+    def _track(self, frame: Frame, lifted: list[LiftedDetection]) -> None:
+        step = self.tracker.update(lifted)
+        h_min = self.config.tracker.h_min
+        busy = {t.object_id for t, _ in step.matches if t.object_id is not None}
+        for t, i in step.matches + step.births:
+            d = lifted[i]
+            obs = Observation(frame_index=frame.index, box=tuple(float(x) for x in d.box),  # type: ignore[arg-type]
+                              mask_area=d.detection.area, score=float(d.detection.score), label=d.detection.label,
+                              distance=d.distance, truncated=d.truncated, visibility=d.visibility)
+            own = t.object_id
+            oid = self.memory.observe(t, d, obs, frame.index, h_min, busy - {own} if own is not None else busy)
+            if oid is not None:
+                busy.add(oid)
+        for t in step.deaths:
+            self.memory.drop(t)
+
+    def finish(self, meta: dict[str, Any] | None = None) -> CapNavMap:
+        """Merge duplicates, export objects, derive occupancy; ``meta`` adds/overrides metadata."""
+        merged = self.memory.merge_duplicates()
+        objects = self.memory.export()
+        occ = occupancy_from_voxels(self.voxels, self.config.occupancy)
+        info: dict[str, Any] = {
+            "frames_used": len(self.frames_used),
+            "first_frame": self.frames_used[0] if self.frames_used else None,
+            "last_frame": self.frames_used[-1] if self.frames_used else None,
+            "frames_skipped": list(self.skipped),
+            "detections_without_depth": self.lift_skips,
+            "tracks": self.tracker._next_id - 1,
+            "merged_duplicates": merged,
+            "detector": self.detector.id,
+            "encoder": self.encoder.id,
+            "text_space": self.encoder.text_space,
+            "config": self.config.to_dict(),
+            "mapping_seconds": round(self.seconds, 3),
+        }
+        info.update(meta or {})
+        return CapNavMap(objects=objects, voxels=self.voxels, occupancy=occ, meta=info)
+
+
+def build_map(frames: Iterable[Frame], config: MapperConfig | None = None, detector: Detector | None = None,
+              encoder: DenseFeatureEncoder | None = None, progress: bool = True, total: int | None = None,
+              meta: dict[str, Any] | None = None) -> CapNavMap:
+    """Map a whole stream. Defaults: the simulator detector (default noise, seed 0) and the
+    label-embedding encoder over MiniLM."""
+    from capnav.perception import create_detector, create_encoder
+
+    det = detector or create_detector("sim", noise="default", seed=0)
+    enc = encoder or create_encoder("label-embedding")
+    mapper = Mapper(config, det, enc)
+    for f in track(frames, "mapping", total=total, enabled=progress):
+        mapper.integrate(f)
+    return mapper.finish(meta)

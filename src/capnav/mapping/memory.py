@@ -1,0 +1,279 @@
+"""Persistent object memory: what survives the tracker (the paper's tracks die; a map must not).
+
+A track feeds nothing until it is confirmed (``h_min`` hits); its first detections are buffered.
+On confirmation it is linked either to an existing object (a revisit: the buffered points overlap
+the object's points in 3D and the labels agree) or to a new object. Linked tracks add every later
+detection to their object. When the track dies the object stays. ``finish`` merges duplicates
+(objects whose points overlap, with compatible labels, never seen together in a frame) and builds
+``MapObject``s with a bounded point sample, extent, footprint and bounded observations.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial import ConvexHull, QhullError, cKDTree
+
+from capnav.core.categories import BY_NAME, confusable
+from capnav.core.errors import InputError
+from capnav.mapping.lifting import LiftedDetection
+from capnav.mapping.objects import MapObject, Observation
+from capnav.mapping.tracker import Track
+
+
+@dataclass(frozen=True)
+class MemoryConfig:
+    """``point_voxel`` dedupes an object's points (3 cm), ``max_points`` caps them (seeded sample);
+    ``max_observations`` keeps the most useful sightings (score x visibility x sqrt(area), halved
+    when truncated). A track re-associates with / an object merges into another when at least
+    ``min_overlap`` of its points lie within ``overlap_radius`` of the other's points, or
+    ``min_inside`` of them inside the other's box grown by ``overlap_radius``, and labels are
+    compatible (equal, in one confusion group, or descriptor cosine >= ``min_cos``). Objects seen
+    together in more than ``max_covisible`` frames are distinct and never merged."""
+
+    point_voxel: float = 0.03
+    max_points: int = 3000
+    max_observations: int = 48
+    overlap_radius: float = 0.08
+    min_overlap: float = 0.25
+    min_inside: float = 0.6
+    min_cos: float = 0.85
+    max_covisible: int = 1
+    min_points: int = 10
+    extent_percentile: float = 1.0
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if self.point_voxel <= 0 or self.max_points < 10 or self.max_observations < 1:
+            raise InputError("point_voxel > 0, max_points >= 10 and max_observations >= 1 are required")
+
+
+@dataclass
+class _ObjectState:
+    id: int
+    points: NDArray[np.float32]
+    colors: NDArray[np.uint8]
+    feature: NDArray[np.float32]
+    feature_weight: float = 0.0
+    votes: dict[str, float] = field(default_factory=dict)
+    observations: list[Observation] = field(default_factory=list)
+    frames: set[int] = field(default_factory=set)
+    hits: int = 0
+    first_frame: int = 0
+    last_frame: int = 0
+    track_ids: list[int] = field(default_factory=list)
+    positions: list[NDArray[np.float64]] = field(default_factory=list)
+
+    @property
+    def label(self) -> str:
+        return max(self.votes, key=lambda k: (self.votes[k], k)) if self.votes else "unknown"
+
+
+def _utility(o: Observation) -> float:
+    return o.score * max(o.visibility, 0.05) * float(np.sqrt(max(o.mask_area, 1))) * (0.5 if o.truncated else 1.0)
+
+
+def labels_compatible(a: str, b: str) -> bool:
+    return a == b or b in confusable(a)
+
+
+class ObjectMemory:
+    """Persistent objects fed by confirmed tracks."""
+
+    def __init__(self, config: MemoryConfig | None = None) -> None:
+        self.config = config or MemoryConfig()
+        self.objects: dict[int, _ObjectState] = {}
+        self._pending: dict[int, list[tuple[LiftedDetection, Observation, int]]] = {}
+        self._next_id = 1
+        self._rng = np.random.default_rng(self.config.seed)
+
+    # ---- per frame ----------------------------------------------------------------------
+    def observe(self, track: Track, det: LiftedDetection, obs: Observation, frame: int,
+                h_min: int, busy: set[int]) -> int | None:
+        """Record one matched/born detection of ``track``; returns the object id once confirmed.
+
+        ``busy`` holds objects already fed by another track in this frame: they are distinct
+        from this one and cannot be re-associated with it."""
+        if track.object_id is None:
+            buf = self._pending.setdefault(track.id, [])
+            buf.append((det, obs, frame))
+            if track.hits < h_min:
+                return None
+            oid = self._link(track, buf, busy)
+            track.object_id = oid
+            for d, o, f in self._pending.pop(track.id):
+                self._add(self.objects[oid], d, o, f)
+            return oid
+        self._add(self.objects[track.object_id], det, obs, frame)
+        return track.object_id
+
+    def drop(self, track: Track) -> None:
+        """A track died: unconfirmed detections are forgotten (false positives), objects stay."""
+        self._pending.pop(track.id, None)
+
+    def _link(self, track: Track, buf: list[tuple[LiftedDetection, Observation, int]], busy: set[int]) -> int:
+        pts = np.concatenate([d.points for d, _, _ in buf]) if buf else np.zeros((0, 3), np.float32)
+        feat = np.mean([d.descriptor for d, _, _ in buf], axis=0) if buf else track.feature
+        best, best_score = None, 0.0
+        for obj in self.objects.values():
+            if obj.id in busy or len(obj.points) == 0 or len(pts) == 0:
+                continue
+            if not self._compatible(track.label, feat, obj):
+                continue
+            score = self._overlap(pts, obj.points)
+            if score > best_score:
+                best, best_score = obj.id, score
+        if best is not None:
+            self.objects[best].track_ids.append(track.id)
+            return best
+        oid = self._next_id
+        self._next_id += 1
+        self.objects[oid] = _ObjectState(id=oid, points=np.zeros((0, 3), np.float32),
+                                         colors=np.zeros((0, 3), np.uint8),
+                                         feature=np.zeros_like(track.feature), track_ids=[track.id])
+        return oid
+
+    def _compatible(self, label: str, feat: NDArray[np.floating], obj: _ObjectState) -> bool:
+        if labels_compatible(label, obj.label) or label in obj.votes:
+            return True
+        na, nb = float(np.linalg.norm(feat)), float(np.linalg.norm(obj.feature))
+        return na > 0 and nb > 0 and float(np.dot(feat, obj.feature)) / (na * nb) >= self.config.min_cos
+
+    def _overlap(self, pts: NDArray[np.float32], ref: NDArray[np.float32]) -> float:
+        """Re-association score in [0, 2]; 0 when neither overlap criterion is met."""
+        cfg = self.config
+        r = cfg.overlap_radius
+        lo, hi = ref.min(axis=0) - r, ref.max(axis=0) + r
+        inside = float(np.all((pts >= lo) & (pts <= hi), axis=1).mean())
+        if inside == 0.0:
+            return 0.0
+        d, _ = cKDTree(ref).query(pts, distance_upper_bound=r)
+        near = float(np.isfinite(d).mean())
+        if near >= cfg.min_overlap or inside >= cfg.min_inside:
+            return near + inside
+        return 0.0
+
+    def _add(self, obj: _ObjectState, det: LiftedDetection, obs: Observation, frame: int) -> None:
+        cfg = self.config
+        w = float(det.detection.score)
+        obj.votes[det.detection.label] = obj.votes.get(det.detection.label, 0.0) + w
+        obj.feature = ((obj.feature * obj.feature_weight + det.descriptor * w) / (obj.feature_weight + w)).astype(
+            np.float32)
+        obj.feature_weight += w
+        obj.hits += 1
+        obj.first_frame = frame if obj.hits == 1 else min(obj.first_frame, frame)
+        obj.last_frame = max(obj.last_frame, frame)
+        obj.frames.add(frame)
+        obj.positions.append(det.position)
+        obj.observations.append(obs)
+        if len(obj.observations) > cfg.max_observations:
+            worst = min(range(len(obj.observations)), key=lambda k: (_utility(obj.observations[k]), k))
+            obj.observations.pop(worst)
+        if len(det.points):
+            self._add_points(obj, det.points, det.colors)
+
+    def _add_points(self, obj: _ObjectState, pts: NDArray[np.float32], cols: NDArray[np.uint8]) -> None:
+        cfg = self.config
+        allp = np.concatenate([obj.points, pts.astype(np.float32)])
+        allc = np.concatenate([obj.colors, cols.astype(np.uint8)])
+        keys = np.floor(allp / cfg.point_voxel).astype(np.int64)
+        _, first = np.unique(keys, axis=0, return_index=True)
+        first.sort()
+        if len(first) > cfg.max_points:
+            first = np.sort(self._rng.choice(first, cfg.max_points, replace=False))
+        obj.points, obj.colors = allp[first], allc[first]
+
+    # ---- end of mapping -----------------------------------------------------------------
+    def merge_duplicates(self) -> int:
+        """Merge objects that overlap in 3D with compatible labels; returns how many were merged."""
+        cfg = self.config
+        ids = sorted(self.objects)
+        merged = 0
+        changed = True
+        while changed:
+            changed = False
+            ids = sorted(self.objects)
+            best: tuple[float, int, int] | None = None
+            for a_i, a in enumerate(ids):
+                oa = self.objects[a]
+                for b in ids[a_i + 1:]:
+                    ob = self.objects[b]
+                    if len(oa.points) == 0 or len(ob.points) == 0:
+                        continue
+                    if len(oa.frames & ob.frames) > cfg.max_covisible:
+                        continue
+                    if not (labels_compatible(oa.label, ob.label) or self._cos(oa, ob) >= cfg.min_cos):
+                        continue
+                    small, big = (oa, ob) if len(oa.points) <= len(ob.points) else (ob, oa)
+                    s = self._overlap(small.points, big.points)
+                    if s > 0 and (best is None or s > best[0]):
+                        best = (s, big.id, small.id)
+            if best is not None:
+                self._absorb(self.objects[best[1]], self.objects.pop(best[2]))
+                merged += 1
+                changed = True
+        return merged
+
+    @staticmethod
+    def _cos(a: _ObjectState, b: _ObjectState) -> float:
+        na, nb = float(np.linalg.norm(a.feature)), float(np.linalg.norm(b.feature))
+        return float(np.dot(a.feature, b.feature)) / (na * nb) if na > 0 and nb > 0 else 0.0
+
+    def _absorb(self, keep: _ObjectState, gone: _ObjectState) -> None:
+        for k, v in gone.votes.items():
+            keep.votes[k] = keep.votes.get(k, 0.0) + v
+        tw = keep.feature_weight + gone.feature_weight
+        if tw > 0:
+            keep.feature = ((keep.feature * keep.feature_weight + gone.feature * gone.feature_weight) / tw).astype(
+                np.float32)
+        keep.feature_weight = tw
+        keep.hits += gone.hits
+        keep.first_frame = min(keep.first_frame, gone.first_frame)
+        keep.last_frame = max(keep.last_frame, gone.last_frame)
+        keep.frames |= gone.frames
+        keep.track_ids += gone.track_ids
+        keep.positions += gone.positions
+        obs = sorted(keep.observations + gone.observations, key=lambda o: (-_utility(o), o.frame_index))
+        keep.observations = sorted(obs[: self.config.max_observations], key=lambda o: o.frame_index)
+        self._add_points(keep, gone.points, gone.colors)
+
+    def export(self) -> list[MapObject]:
+        """``MapObject``s in id order, renumbered 1..n; objects with too few points are dropped."""
+        out: list[MapObject] = []
+        for obj in sorted(self.objects.values(), key=lambda o: o.id):
+            if len(obj.points) < self.config.min_points:
+                continue
+            out.append(self._to_map_object(obj, len(out) + 1))
+        return out
+
+    def _to_map_object(self, obj: _ObjectState, new_id: int) -> MapObject:
+        p = obj.points.astype(np.float64)
+        q = self.config.extent_percentile
+        lo = np.percentile(p, q, axis=0)
+        hi = np.percentile(p, 100.0 - q, axis=0)
+        fp = footprint(p[:, :2])
+        label = obj.label
+        cat = BY_NAME.get(label)
+        mo = MapObject(
+            id=new_id, label=label, label_votes=dict(sorted(obj.votes.items())), position=(lo + hi) / 2.0,
+            extent_min=lo, extent_max=hi, footprint=fp, points=obj.points.copy(), colors=obj.colors.copy(),
+            feature=obj.feature.copy(), hits=obj.hits, first_frame=obj.first_frame, last_frame=obj.last_frame,
+            observations=sorted(obj.observations, key=lambda o: o.frame_index),
+        )
+        mo.category_id = cat.id if cat else 0
+        mo.track_ids = list(obj.track_ids)
+        return mo
+
+
+def footprint(xy: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Counter-clockwise convex hull (K, 2) of x, y points; the bounding rectangle when degenerate."""
+    if len(xy) >= 3:
+        try:
+            hull = ConvexHull(xy)
+            return np.asarray(xy[hull.vertices], dtype=np.float64)
+        except QhullError:
+            pass
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    return np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]], dtype=np.float64)
