@@ -1,0 +1,67 @@
+"""Episode generation on a hand-built apartment truth (no simulator needed)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from capnav.core.errors import DatasetError
+from capnav.core.grid import GridSpec
+from capnav.eval.generate import EpisodeConfig, SceneTruth, description_episodes, label_episodes
+
+
+def box(x: float, y: float, s: float = 0.4) -> np.ndarray:
+    return np.array([[x, y], [x + s, y], [x + s, y + s], [x, y + s]])
+
+
+def truth() -> SceneTruth:
+    spec = GridSpec(0.0, 0.0, 0.1, 80, 80)
+    nav = np.ones((80, 80), dtype=bool)
+    cats = {1: "sofa", 2: "sofa", 3: "chair", 4: "chair", 5: "tv", 6: "bed"}
+    fps = {1: box(1, 1), 2: box(6, 6), 3: box(1, 6), 4: box(3, 3), 5: box(6, 1), 6: box(4, 7)}
+    for f in fps.values():  # objects are not navigable
+        rc = spec.to_cell(f)
+        nav[rc[:, 0].min(): rc[:, 0].max() + 1, rc[:, 1].min(): rc[:, 1].max() + 1] = False
+    return SceneTruth(7, cats, fps, spec, nav)
+
+
+def test_label_episodes_are_valid_and_seeded() -> None:
+    t = truth()
+    a = label_episodes(t, np.random.default_rng(3), EpisodeConfig(episodes_per_scene=5))
+    b = label_episodes(truth(), np.random.default_rng(3), EpisodeConfig(episodes_per_scene=5))
+    assert [e.model_dump() for e in a] == [e.model_dump() for e in b]
+    for e in a:
+        cats = [g.category for g in e.subgoals]
+        assert len(cats) == 4 and len(set(cats)) == 4  # 4 categories present: no repeats
+        for g in e.subgoals:
+            assert g.text == g.category and g.target_ids == t.instances_of(g.category)
+        assert t.navigable[tuple(t.spec.to_cell(np.array([e.start.x, e.start.y])))]
+        assert t.field(e.subgoals[0].target_ids).at((e.start.x, e.start.y)) >= 1.0
+
+
+def test_description_episodes_prefer_lookalikes() -> None:
+    t = truth()
+    seen: list[tuple[int, tuple[float, float] | None]] = []
+
+    def describe(i: int, robot_xy: tuple[float, float] | None, rng: np.random.Generator) -> tuple[str, str]:
+        seen.append((i, robot_xy))
+        return f"the {t.categories[i]} number {i}", "attribute"
+
+    eps = description_episodes(t, describe, np.random.default_rng(0), EpisodeConfig(episodes_per_scene=3))
+    for e in eps:
+        ids = [g.target_ids[0] for g in e.subgoals]
+        assert set(ids) <= {1, 2, 3, 4}  # only categories with two instances
+        assert len(set(ids)) == 4
+        cats = [t.categories[i] for i in ids]
+        assert all(a != b for a, b in zip(cats, cats[1:], strict=False))
+        assert e.subgoals[1].text == f"the {cats[1]} number {ids[1]}"
+    # robot position only for the first subgoal of each episode
+    assert [xy is not None for _, xy in seen] == [True, False, False, False] * 3
+
+
+def test_unreachable_scene_is_a_clear_error() -> None:
+    t = truth()
+    t.navigable[:] = False
+    t.navigable[0, 0] = True
+    with pytest.raises(DatasetError, match="no valid label episode"):
+        label_episodes(t, np.random.default_rng(0), EpisodeConfig(episodes_per_scene=1, max_tries=5))
