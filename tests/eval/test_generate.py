@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -53,7 +55,7 @@ def test_description_episodes_prefer_lookalikes() -> None:
         assert set(ids) <= {1, 2, 3, 4}  # only categories with two instances
         assert len(set(ids)) == 4
         cats = [t.categories[i] for i in ids]
-        assert all(a != b for a, b in zip(cats, cats[1:], strict=False))
+        assert all(a != b for a, b in itertools.pairwise(cats))
         assert e.subgoals[1].text == f"the {cats[1]} number {ids[1]}"
     # robot position only for the first subgoal of each episode
     assert [xy is not None for _, xy in seen] == [True, False, False, False] * 3
