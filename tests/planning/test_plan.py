@@ -108,7 +108,7 @@ def test_start_in_inflation_band_snaps_with_a_note() -> None:
     path = plan_path(occ, (0.12, 2.5), (3.0, 2.5))  # 0.07 m from the wall's cell
     assert path.notes and "snapped" in path.notes[0]
     assert np.allclose(path.waypoints[0], (0.12, 2.5))
-    assert build_costmap(occ).weights[tuple(path.cells[0])] == 1.0
+    assert np.isfinite(build_costmap(occ).weights[tuple(path.cells[0])])
 
 
 def test_goal_within_reach_and_facing_the_object() -> None:
@@ -150,3 +150,18 @@ def test_goal_prefers_the_near_side_of_a_wall() -> None:
 def test_bad_footprint() -> None:
     with pytest.raises(InputError, match=r"\(K, 2\)"):
         select_goal(room(), np.zeros((3,)), (1.0, 1.0))
+
+
+def test_clearance_cost_centres_the_path_in_a_corridor() -> None:
+    occ = room()
+    occ.cells[:40, 30:90] = OCCUPIED  # a 0.95 m wide corridor between y = 2.0 and the top wall
+    occ.cells[60:, 30:90] = OCCUPIED
+    start, goal = (0.5, 2.5), (5.5, 2.5)
+    hug = plan_path(occ, (0.5, 2.15), (5.5, 2.15), PlannerConfig(clearance_cost=0.0))
+    mid = plan_path(occ, (0.5, 2.15), (5.5, 2.15), PlannerConfig(clearance_cost=2.0))
+    ys_hug = densify(hug.waypoints)[:, 1]
+    ys_mid = densify(mid.waypoints)[:, 1]
+    inside = slice(len(ys_mid) // 3, 2 * len(ys_mid) // 3)
+    assert abs(np.median(ys_mid[inside]) - 2.5) < 0.1  # the corridor's centre line
+    assert abs(np.median(ys_hug[len(ys_hug) // 3: 2 * len(ys_hug) // 3]) - 2.5) > 0.1
+    plan_path(occ, start, goal)

@@ -15,11 +15,13 @@ class PlannerConfig:
     little inside it (``goal_margin``) so a slightly wrong mapped footprint still counts as reached.
     """
 
-    robot_radius: float = 0.18  # m, the agent's base radius (sim agent)
+    robot_radius: float = 0.2  # m, the agent's base radius (the simulator agent's default)
     safety_margin: float = 0.05  # m, added to the radius when obstacles are inflated
     reach: float = 1.0  # m, success radius around the object's footprint
     goal_margin: float = 0.3  # m, aim at cells within reach - goal_margin when possible
     unknown_cost: float | None = 3.0  # weight of an unknown cell; None = unknown is blocked
+    clearance_band: float = 0.25  # m beyond the inflation where cells cost extra (keeps off walls)
+    clearance_cost: float = 1.0  # extra weight at the inflation edge, fading to 0 across the band
     backend: str = "numba"  # grid search backend (see capnav.planning.backends.BACKENDS)
     simplify: bool = True  # line-of-sight simplification of the cell path into waypoints
     escape_radius: float = 0.5  # m, a start inside the inflation band snaps to a free cell this close
@@ -28,7 +30,8 @@ class PlannerConfig:
     max_steps: int = 2000  # discrete-action budget when the agent has no move_to
 
     def __post_init__(self) -> None:
-        for name in ("robot_radius", "safety_margin", "goal_margin", "escape_radius", "blocked_mark_radius"):
+        for name in ("robot_radius", "safety_margin", "goal_margin", "escape_radius", "blocked_mark_radius",
+                     "clearance_band", "clearance_cost"):
             v = getattr(self, name)
             if not v >= 0.0:
                 raise InputError(f"PlannerConfig.{name} must be >= 0, got {v}")

@@ -47,13 +47,19 @@ def check_occupancy(occ: object) -> OccupancyGrid:
 
 
 def build_costmap(occ: OccupancyGrid, config: PlannerConfig | None = None) -> Costmap:
-    """Inflate obstacles and price unknown space as the config says."""
+    """Inflate obstacles, add the clearance cost near them and price unknown space."""
     cfg = config or PlannerConfig()
     occ = check_occupancy(occ)
-    grown = occ.inflated(cfg.inflation).cells
-    w = np.ones(grown.shape, np.float64)
-    w[grown == UNKNOWN] = np.inf if cfg.unknown_cost is None else cfg.unknown_cost
-    w[grown == OCCUPIED] = np.inf
+    obstacle = occ.cells == OCCUPIED
+    w = np.ones(occ.cells.shape, np.float64)
+    if obstacle.any():
+        dist = ndimage.distance_transform_edt(~obstacle) * occ.spec.resolution
+        if cfg.clearance_cost > 0 and cfg.clearance_band > 0:
+            w += cfg.clearance_cost * np.clip(1.0 - (dist - cfg.inflation) / cfg.clearance_band, 0.0, 1.0)
+        w[dist <= cfg.inflation] = np.inf
+    unknown = occ.cells == UNKNOWN
+    w[unknown] = np.inf if cfg.unknown_cost is None else np.maximum(w[unknown], cfg.unknown_cost)
+    w[obstacle] = np.inf
     return Costmap(OccupancyGrid(occ.spec, occ.cells.copy()), w)
 
 
