@@ -3,9 +3,12 @@ frames with ground-truth instance / category images (independent of the simulato
 
 from __future__ import annotations
 
+import hashlib
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from capnav.core.frame import Frame
 from capnav.core.geometry import Intrinsics, look_at_pose
@@ -22,6 +25,21 @@ class Box:
     @property
     def center(self) -> np.ndarray:
         return (np.array(self.lo) + np.array(self.hi)) / 2
+
+
+class HashEmbedder:
+    """Unit vectors seeded by the text's sha256: equal texts give equal vectors, others ~orthogonal."""
+
+    model_id = "test-hash-32"
+    dim = 32
+
+    def embed(self, texts: Sequence[str]) -> NDArray[np.float32]:
+        out = []
+        for t in texts:
+            seed = int.from_bytes(hashlib.sha256(t.encode()).digest()[:8], "little")
+            v = np.random.default_rng(seed).standard_normal(self.dim)
+            out.append(v / np.linalg.norm(v))
+        return np.asarray(out, dtype=np.float32).reshape(len(out), self.dim)
 
 
 ROOM = ((-3.0, -3.0, 0.0), (3.0, 3.0, 2.5))

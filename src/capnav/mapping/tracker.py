@@ -118,19 +118,21 @@ class SG3DTracker:
         self.step = 0
         self._next_id = 1
 
-    def predict(self) -> NDArray[np.float64]:
-        """Step 1, eq. 11: p_pred = p + v * dt (dt in frames since the last match)."""
+    def predict(self, step: int | None = None) -> NDArray[np.float64]:
+        """Step 1, eq. 11: p_pred = p + v * dt at ``step`` (default: the next frame), dt in frames
+        since each track's last match."""
         if not self.tracks:
             return np.zeros((0, 3))
+        at = self.step + 1 if step is None else step
         p = np.stack([t.position for t in self.tracks])
         v = np.stack([t.velocity for t in self.tracks])
-        dt = np.array([self.step - t.last_update for t in self.tracks], dtype=np.float64)[:, None]
+        dt = np.array([at - t.last_update for t in self.tracks], dtype=np.float64)[:, None]
         return p + v * dt
 
     def update(self, dets: Sequence[LiftedDetection]) -> TrackerStep:
         cfg = self.config
         self.step += 1
-        pred = self.predict()
+        pred = self.predict(self.step)
         n_t, n_d = len(self.tracks), len(dets)
         cost = np.full((n_t, n_d), np.inf)
         matches: list[tuple[Track, int]] = []

@@ -1,0 +1,268 @@
+"""The CapNav map file: one zip archive, no pickle, validated on load.
+
+Layout (format ``capnav-map``, version 1)::
+
+    header.json            format, version, and for every other entry: sha256, size, and for
+                           arrays their dtype and shape
+    meta.json caches.json  the map's JSON-able metadata and the later stages' caches
+    objects.json           per object: scalar / JSON fields, observations, views (without bytes),
+                           and the shape of each of its arrays
+    objects/<field>.npy    that array field of every object, flattened and concatenated
+    views/<o>_<k>_<kind>.png  view PNG bytes (frame / crop)
+    voxels/*.npy, occupancy/cells.npy, grids in objects.json / header.json
+
+Arrays are ``.npy`` written and read with ``allow_pickle=False``. Loading checks the format name,
+the version, every entry's presence, checksum, dtype and shape, and the cross-array consistency;
+any failure is a ``MapFileError`` that names the file and what is wrong. Writes are atomic.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import io
+import json
+import zipfile
+import zlib
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from capnav.core.atomic import write_with
+from capnav.core.errors import CapNavError, MapFileError
+from capnav.core.grid import GridSpec, OccupancyGrid
+from capnav.mapping.cmap import CapNavMap
+from capnav.mapping.objects import MapObject, ObjectView, Observation
+from capnav.mapping.voxel_map import VoxelMap
+
+FORMAT = "capnav-map"
+VERSION = 1
+_OBJ_FIELDS = [f.name for f in dataclasses.fields(MapObject)]
+_ARRAY_DTYPES = {"position": np.float64, "extent_min": np.float64, "extent_max": np.float64,
+                 "footprint": np.float64, "points": np.float32, "colors": np.uint8, "feature": np.float32,
+                 "embedding": np.float32}
+
+
+def _npy(arr: NDArray[Any]) -> bytes:
+    buf = io.BytesIO()
+    np.save(buf, np.ascontiguousarray(arr), allow_pickle=False)
+    return buf.getvalue()
+
+
+def _json(obj: Any, what: str) -> bytes:
+    try:
+        return json.dumps(obj, indent=1, allow_nan=True).encode("utf-8")
+    except (TypeError, ValueError) as e:
+        raise MapFileError(f"cannot save the map: {what} is not JSON-serialisable ({e})") from None
+
+
+def _encode_objects(objects: list[MapObject]) -> tuple[list[dict[str, Any]], dict[str, bytes]]:
+    records: list[dict[str, Any]] = []
+    blobs: dict[str, bytes] = {}
+    arrays: dict[str, list[NDArray[Any]]] = {}
+    for n, o in enumerate(objects):
+        rec: dict[str, Any] = {"arrays": {}}
+        for name in _OBJ_FIELDS:
+            val = getattr(o, name)
+            if name in _ARRAY_DTYPES:
+                if val is None:
+                    rec["arrays"][name] = None
+                    continue
+                a = np.asarray(val, dtype=_ARRAY_DTYPES[name])
+                rec["arrays"][name] = list(a.shape)
+                arrays.setdefault(name, []).append(a.reshape(-1))
+            elif name == "observations":
+                rec[name] = [dataclasses.asdict(ob) for ob in val]
+            elif name == "views":
+                views = []
+                for k, v in enumerate(val):
+                    d = dataclasses.asdict(v)
+                    for kind in ("frame_png", "crop_png"):
+                        data = d.pop(kind)
+                        key = f"views/{n}_{k}_{kind[:-4]}.png"
+                        d[kind] = key if data else None
+                        if data:
+                            blobs[key] = bytes(data)
+                    views.append(d)
+                rec[name] = views
+            else:
+                rec[name] = val
+        records.append(rec)
+    for name, dtype in _ARRAY_DTYPES.items():
+        parts = arrays.get(name, [])
+        blobs[f"objects/{name}.npy"] = _npy(np.concatenate(parts) if parts else np.zeros(0, dtype=dtype))
+    return records, blobs
+
+
+def save_map(cmap: CapNavMap, path: str | Path) -> Path:
+    """Write ``cmap`` to ``path`` atomically (a crash never leaves a half-written map)."""
+    vox = cmap.voxels
+    records, blobs = _encode_objects(cmap.objects)
+    blobs["voxels/coords.npy"] = _npy(vox.coords)
+    blobs["voxels/colors.npy"] = _npy(vox.colors)
+    blobs["voxels/weights.npy"] = _npy(vox.weights)
+    blobs["voxels/features.npy"] = _npy(vox.features)
+    if vox.projection is not None:
+        blobs["voxels/projection.npy"] = _npy(vox.projection)
+    blobs["occupancy/cells.npy"] = _npy(cmap.occupancy.cells)
+    blobs["objects.json"] = _json(records, "an object field")
+    blobs["meta.json"] = _json(cmap.meta, "meta")
+    blobs["caches.json"] = _json(cmap.caches, "caches")
+    entries: dict[str, dict[str, Any]] = {}
+    for name, data in blobs.items():
+        e: dict[str, Any] = {"sha256": hashlib.sha256(data).hexdigest(), "bytes": len(data)}
+        if name.endswith(".npy"):
+            arr = np.load(io.BytesIO(data), allow_pickle=False)
+            e["dtype"], e["shape"] = arr.dtype.str, list(arr.shape)
+        entries[name] = e
+    header = {
+        "format": FORMAT, "version": VERSION, "n_objects": len(cmap.objects), "n_voxels": len(vox),
+        "voxels": {"resolution": vox.resolution, "origin": vox.origin.tolist(), "dim": vox.dim,
+                   "text_space": vox.text_space},
+        "occupancy": cmap.occupancy.spec.to_dict(), "entries": entries,
+    }
+
+    def writer(fh: IO[bytes]) -> None:
+        with zipfile.ZipFile(fh, "w") as zf:
+            for name, data in blobs.items():
+                compress = zipfile.ZIP_DEFLATED if name.endswith(".json") else zipfile.ZIP_STORED
+                zf.writestr(name, data, compress_type=compress)
+            zf.writestr("header.json", _json(header, "header"), compress_type=zipfile.ZIP_DEFLATED)
+
+    out = Path(path)
+    write_with(out, writer)
+    return out
+
+
+class _Reader:
+    def __init__(self, path: Path, zf: zipfile.ZipFile, header: dict[str, Any]) -> None:
+        self.path, self.zf, self.entries = path, zf, header["entries"]
+
+    def fail(self, msg: str) -> MapFileError:
+        return MapFileError(f"{self.path}: {msg}")
+
+    def raw(self, name: str) -> bytes:
+        if name not in self.entries:
+            raise self.fail(f"entry {name!r} is missing from the header")
+        try:
+            data = self.zf.read(name)
+        except KeyError:
+            raise self.fail(f"entry {name!r} is missing (truncated file?)") from None
+        except (zipfile.BadZipFile, zlib.error, EOFError, OSError) as e:
+            raise self.fail(f"entry {name!r} is unreadable ({e}); the file is corrupt or truncated") from None
+        e = self.entries[name]
+        if len(data) != e.get("bytes") or hashlib.sha256(data).hexdigest() != e.get("sha256"):
+            raise self.fail(f"entry {name!r} fails its sha256 checksum (corrupted)")
+        return data
+
+    def json(self, name: str) -> Any:
+        try:
+            return json.loads(self.raw(name).decode("utf-8"))
+        except (UnicodeDecodeError, json.JSONDecodeError) as e:
+            raise self.fail(f"entry {name!r} is not valid JSON ({e})") from None
+
+    def array(self, name: str) -> NDArray[Any]:
+        data = self.raw(name)
+        try:
+            arr = np.load(io.BytesIO(data), allow_pickle=False)
+        except (ValueError, OSError) as e:
+            raise self.fail(f"array {name!r} is not a valid .npy without pickles ({e})") from None
+        e = self.entries[name]
+        if arr.dtype.str != e.get("dtype") or list(arr.shape) != e.get("shape"):
+            raise self.fail(f"array {name!r} is {arr.dtype.str} {list(arr.shape)}, header says "
+                            f"{e.get('dtype')} {e.get('shape')}")
+        return arr
+
+
+def load_map(path: str | Path) -> CapNavMap:
+    """Read and validate a map file; any problem raises ``MapFileError`` saying what is wrong."""
+    p = Path(path)
+    if not p.is_file():
+        raise MapFileError(f"map file not found: {p}")
+    try:
+        zf = zipfile.ZipFile(p, "r")
+    except (zipfile.BadZipFile, OSError) as e:
+        raise MapFileError(f"{p}: not a CapNav map file or truncated ({e})") from None
+    with zf:
+        try:
+            header = json.loads(zf.read("header.json").decode("utf-8"))
+        except KeyError:
+            raise MapFileError(f"{p}: no header.json; not a CapNav map file or truncated") from None
+        except (zipfile.BadZipFile, zlib.error, EOFError, OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+            raise MapFileError(f"{p}: header.json is unreadable ({e})") from None
+        if not isinstance(header, dict) or header.get("format") != FORMAT:
+            fmt = header.get("format") if isinstance(header, dict) else None
+            raise MapFileError(f"{p}: not a CapNav map (format {fmt!r}, expected {FORMAT!r})")
+        if header.get("version") != VERSION:
+            raise MapFileError(f"{p}: map format version {header.get('version')} is not supported (this CapNav "
+                               f"reads version {VERSION}); rebuild the map with `capnav map`")
+        if not isinstance(header.get("entries"), dict):
+            raise MapFileError(f"{p}: header has no entry table")
+        r = _Reader(p, zf, header)
+        try:
+            return _decode(r, header)
+        except MapFileError:
+            raise
+        except (CapNavError, KeyError, TypeError, ValueError, IndexError) as e:
+            raise r.fail(f"inconsistent content ({type(e).__name__}: {e})") from None
+
+
+def _decode(r: _Reader, header: dict[str, Any]) -> CapNavMap:
+    vh = header["voxels"]
+    proj = r.array("voxels/projection.npy") if "voxels/projection.npy" in r.entries else None
+    coords = r.array("voxels/coords.npy")
+    n = int(header["n_voxels"])
+    if coords.shape != (n, 3):
+        raise r.fail(f"voxels/coords has shape {coords.shape}, header says {n} voxels")
+    voxels = VoxelMap.from_arrays(float(vh["resolution"]), np.asarray(vh["origin"]), coords,
+                                  r.array("voxels/colors.npy"), r.array("voxels/weights.npy"),
+                                  r.array("voxels/features.npy"), proj, str(vh.get("text_space", "")))
+    spec = GridSpec(**header["occupancy"])
+    occ = OccupancyGrid(spec, r.array("occupancy/cells.npy"))
+    records = r.json("objects.json")
+    if not isinstance(records, list) or len(records) != int(header["n_objects"]):
+        raise r.fail(f"objects.json holds {len(records) if isinstance(records, list) else '?'} objects, "
+                     f"header says {header['n_objects']}")
+    flat = {name: r.array(f"objects/{name}.npy") for name in _ARRAY_DTYPES}
+    offs = dict.fromkeys(_ARRAY_DTYPES, 0)
+    objects: list[MapObject] = []
+    for rec in records:
+        kw: dict[str, Any] = {}
+        for name, shape in rec["arrays"].items():
+            if name not in _ARRAY_DTYPES:
+                raise r.fail(f"unknown object array {name!r}")
+            if shape is None:
+                kw[name] = None
+                continue
+            size = int(np.prod(shape)) if shape else 1
+            chunk = flat[name][offs[name]: offs[name] + size]
+            if chunk.size != size:
+                raise r.fail(f"objects/{name}.npy is too short for object {rec.get('id')}")
+            kw[name] = chunk.reshape(shape).copy()
+            offs[name] += size
+        for name in _OBJ_FIELDS:
+            if name in _ARRAY_DTYPES or name not in rec:
+                continue
+            if name == "observations":
+                kw[name] = [Observation(**{**d, "box": tuple(d["box"])}) for d in rec[name]]
+            elif name == "views":
+                views = []
+                for d in rec[name]:
+                    d = dict(d)
+                    for kind in ("frame_png", "crop_png"):
+                        d[kind] = r.raw(d[kind]) if d.get(kind) else b""
+                    views.append(ObjectView(**{**d, "box": tuple(d["box"])}))
+                kw[name] = views
+            else:
+                kw[name] = rec[name]
+        objects.append(MapObject(**kw))
+    for name, arr in flat.items():
+        if offs[name] != arr.size:
+            raise r.fail(f"objects/{name}.npy has {arr.size - offs[name]} values no object claims")
+    meta = r.json("meta.json")
+    caches = r.json("caches.json")
+    if not isinstance(meta, dict) or not isinstance(caches, dict):
+        raise r.fail("meta.json and caches.json must hold JSON objects")
+    return CapNavMap(objects=objects, voxels=voxels, occupancy=occ, meta=meta, caches=caches)

@@ -1,0 +1,118 @@
+"""The map file round-trips everything and rejects corrupt, truncated or foreign files clearly."""
+
+from __future__ import annotations
+
+import hashlib
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "mapping"))
+from _synth_scene import HashEmbedder, orbit
+
+from capnav.core.errors import MapFileError
+from capnav.io.mapfile import load_map, save_map
+from capnav.mapping import CapNavMap, ObjectView, build_map
+from capnav.perception import create_detector, create_encoder
+
+
+@pytest.fixture(scope="module")
+def cmap() -> CapNavMap:
+    m = build_map(orbit(30), detector=create_detector("sim", noise="default", seed=0),
+                  encoder=create_encoder("label-embedding", embedder=HashEmbedder()), progress=False,
+                  meta={"dataset": "synthetic"})
+    assert len(m.objects) >= 3
+    o = m.objects[0]
+    o.views = [ObjectView(frame_index=3, box=(1.0, 2.0, 30.0, 40.0), score=0.7, frame_png=b"\x89PNG-frame",
+                          crop_png=b"\x89PNG-crop"), ObjectView(frame_index=5, box=(0, 0, 1, 1), score=0.1)]
+    o.caption, o.caption_source = "SOFA, a grey sofa.", "template"
+    o.embedding, o.embedding_model = np.arange(8, dtype=np.float32) / 10, "test-model"
+    m.caches = {"captions": {"k": "v"}, "verify": {"q": [1, 2]}}
+    return m
+
+
+def _same_object(a, b) -> None:  # type: ignore[no-untyped-def]
+    for name in a.__dataclass_fields__:
+        va, vb = getattr(a, name), getattr(b, name)
+        if isinstance(va, np.ndarray):
+            assert vb.dtype == va.dtype and vb.shape == va.shape
+            np.testing.assert_array_equal(va, vb)
+        else:
+            assert va == vb, name
+
+
+def test_round_trip_everything(cmap: CapNavMap, tmp_path: Path) -> None:
+    p = save_map(cmap, tmp_path / "m.capnav")
+    back = load_map(p)
+    assert len(back.objects) == len(cmap.objects)
+    for a, b in zip(cmap.objects, back.objects, strict=True):
+        _same_object(a, b)
+    assert back.objects[0].views[0].frame_png == b"\x89PNG-frame"
+    assert back.objects[1].embedding is None
+    v, w = cmap.voxels, back.voxels
+    for name in ("coords", "colors", "weights", "features", "projection", "origin"):
+        np.testing.assert_array_equal(getattr(v, name), getattr(w, name))
+    assert w.resolution == v.resolution and w.text_space == v.text_space
+    np.testing.assert_array_equal(back.occupancy.cells, cmap.occupancy.cells)
+    assert back.occupancy.spec == cmap.occupancy.spec
+    assert back.caches == cmap.caches
+    assert back.meta["dataset"] == "synthetic" and back.meta["frames_used"] == 30
+    # a loaded voxel map still answers slot lookups and queries identically
+    np.testing.assert_array_equal(w.slots(v.coords[:50]), np.arange(50))
+    q = np.random.default_rng(0).standard_normal(32)
+    np.testing.assert_allclose(w.query(q), v.query(q))
+
+
+def test_save_is_deterministic(cmap: CapNavMap, tmp_path: Path) -> None:
+    a = save_map(cmap, tmp_path / "a.capnav").read_bytes()
+    b = save_map(cmap, tmp_path / "b.capnav").read_bytes()
+    digest = [hashlib.sha256(zipfile.ZipFile(tmp_path / n).read("voxels/features.npy")).hexdigest()
+              for n in ("a.capnav", "b.capnav")]
+    assert digest[0] == digest[1] and len(a) == len(b)
+
+
+def test_truncated_file(cmap: CapNavMap, tmp_path: Path) -> None:
+    p = save_map(cmap, tmp_path / "m.capnav")
+    data = p.read_bytes()
+    for cut in (10, len(data) // 2, len(data) - 40):
+        bad = tmp_path / f"cut{cut}.capnav"
+        bad.write_bytes(data[:cut])
+        with pytest.raises(MapFileError):
+            load_map(bad)
+
+
+def test_corrupted_entry_is_named(cmap: CapNavMap, tmp_path: Path) -> None:
+    p = save_map(cmap, tmp_path / "m.capnav")
+    src = zipfile.ZipFile(p)
+    bad = tmp_path / "bad.capnav"
+    with zipfile.ZipFile(bad, "w") as zf:
+        for info in src.infolist():
+            data = src.read(info.filename)
+            if info.filename == "voxels/weights.npy":
+                data = data[:-8] + b"\x00" * 8
+            zf.writestr(info.filename, data)
+    with pytest.raises(MapFileError, match=r"voxels/weights\.npy.*checksum"):
+        load_map(bad)
+
+
+def test_wrong_version_and_foreign_files(cmap: CapNavMap, tmp_path: Path) -> None:
+    p = save_map(cmap, tmp_path / "m.capnav")
+    src = zipfile.ZipFile(p)
+    bad = tmp_path / "v9.capnav"
+    with zipfile.ZipFile(bad, "w") as zf:
+        for info in src.infolist():
+            data = src.read(info.filename)
+            if info.filename == "header.json":
+                data = data.replace(b'"version": 1', b'"version": 9')
+            zf.writestr(info.filename, data)
+    with pytest.raises(MapFileError, match="version 9"):
+        load_map(bad)
+    txt = tmp_path / "x.capnav"
+    txt.write_text("hello")
+    with pytest.raises(MapFileError, match="not a CapNav map"):
+        load_map(txt)
+    with pytest.raises(MapFileError, match="not found"):
+        load_map(tmp_path / "missing.capnav")

@@ -1,0 +1,70 @@
+"""Persistence beyond the tracker: revisits re-associate, false positives never become objects,
+distinct lookalikes stay distinct, duplicates merge at finish()."""
+
+from __future__ import annotations
+
+import numpy as np
+from _synth_scene import Box, default_boxes, render
+
+from capnav.core.geometry import Intrinsics, look_at_pose
+from capnav.mapping import Mapper, MapperConfig, TrackerConfig
+from capnav.perception import create_detector, create_encoder
+
+
+def _look(yaws: list[float], boxes: list[Box], eye: tuple[float, float, float] = (0.0, 0.0, 1.2)) -> list:
+    K = Intrinsics.from_fov(160, 120, 60.0)
+    return [render(boxes, look_at_pose(np.array(eye), yaw=y, pitch=np.deg2rad(25)), K, index=i)
+            for i, y in enumerate(yaws)]
+
+
+def _mapper(embedder, noise: str = "oracle", **tracker) -> Mapper:  # type: ignore[no-untyped-def]
+    cfg = MapperConfig(tracker=TrackerConfig(**tracker))
+    enc = create_encoder("label-embedding", embedder=embedder)
+    return Mapper(cfg, create_detector("sim", noise=noise, seed=0), enc)
+
+
+def test_revisit_reassociates_instead_of_duplicating(embedder) -> None:  # type: ignore[no-untyped-def]
+    boxes = [b for b in default_boxes() if b.instance == 1]  # the sofa at (-1.6, -2.05)
+    toward = float(np.arctan2(-2.05, -1.6))
+    away = toward + np.pi
+    yaws = [toward + 0.02 * k for k in range(8)] + [away] * 15 + [toward - 0.02 * k for k in range(8)]
+    m = _mapper(embedder, m_max=5)
+    for f in _look(yaws, boxes):
+        m.integrate(f)
+    assert m.tracker._next_id - 1 == 2  # the first track died while looking away; a second was born
+    cmap = m.finish()
+    sofas = cmap.by_label("sofa")
+    assert len(sofas) == 1
+    assert len(sofas[0].track_ids) == 2 and cmap.meta["merged_duplicates"] == 0  # linked on confirmation
+    assert sofas[0].hits == 16
+    np.testing.assert_allclose(sofas[0].position[:2], [-1.6, -2.05], atol=0.25)
+
+
+def test_lookalikes_stay_distinct_and_extent_is_measured(embedder) -> None:  # type: ignore[no-untyped-def]
+    boxes = [Box((1.0, -1.0, 0.0), (1.5, -0.5, 0.9), 1, 3, (200, 0, 0)),
+             Box((1.0, -0.3, 0.0), (1.5, 0.2, 0.9), 2, 3, (0, 0, 200))]
+    yaws = [0.0 + 0.01 * k for k in range(12)]
+    m = _mapper(embedder)
+    for f in _look(yaws, boxes, eye=(-1.0, -0.4, 1.2)):
+        m.integrate(f)
+    cmap = m.finish()
+    chairs = sorted(cmap.by_label("chair"), key=lambda o: o.position[1])
+    assert len(chairs) == 2
+    assert chairs[0].position[1] < -0.5 < chairs[1].position[1]
+    for o in chairs:
+        assert 0.8 < o.extent_max[2] < 0.95  # top of a 0.9 m chair
+        assert o.footprint.shape[1] == 2 and len(o.footprint) >= 3
+        assert len(o.points) == len(o.colors) > 50
+        assert o.observations and all(0.0 <= ob.visibility <= 1.0 for ob in o.observations)
+    red = chairs[0].colors.astype(float).mean(axis=0)
+    assert red[0] > 150 and red[2] < 60
+
+
+def test_false_positives_and_short_tracks_never_become_objects(embedder) -> None:  # type: ignore[no-untyped-def]
+    yaws = [0.3 * k for k in range(20)]
+    m = Mapper(MapperConfig(), create_detector("sim", noise="default", seed=1, fp_rate=3.0),
+               create_encoder("label-embedding", embedder=embedder))
+    for f in _look(yaws, []):  # an empty room: every detection is a false positive
+        m.integrate(f)
+    assert m.tracker._next_id > 20  # plenty of false detections ...
+    assert m.finish().objects == []  # ... none of them confirmed (random labels and places)

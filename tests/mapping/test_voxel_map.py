@@ -1,0 +1,97 @@
+"""Eq. 4-8 against a direct per-voxel computation, queries, and occupancy."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from capnav.core.errors import InputError
+from capnav.core.grid import FREE, OCCUPIED, UNKNOWN, GridSpec
+from capnav.mapping import OccupancyConfig, VoxelMap, occupancy_from_voxels, radial_weight, random_projection
+
+
+def test_radial_weight_is_eq5() -> None:
+    p = np.array([[0.0, 0.0, 1.0], [1.0, 2.0, 2.0], [0.0, 0.0, 0.0]], dtype=np.float32)
+    sigma = 1.5
+    expect = np.exp(-(p**2).sum(1) / (2 * sigma**2))
+    np.testing.assert_allclose(radial_weight(p, sigma), expect, rtol=1e-6)
+
+
+def test_fusion_matches_direct_weighted_average() -> None:
+    rng = np.random.default_rng(3)
+    res, origin = 0.1, (-0.35, 0.2, -1.0)
+    vm = VoxelMap(res, origin, feature_dim=8, capacity=16)  # tiny capacity forces growth + rehash
+    all_pts, all_a, all_c, all_f = [], [], [], []
+    for _ in range(5):  # five "frames"
+        n = 700
+        pts = rng.uniform(-0.5, 0.5, (n, 3))
+        a = rng.uniform(0.05, 1.0, n).astype(np.float32)
+        col = rng.integers(0, 256, (n, 3)).astype(np.uint8)
+        phi = rng.standard_normal((20, 8)).astype(np.float32)
+        idx = rng.integers(0, 20, n)
+        vm.integrate(pts, a, col, idx, phi)
+        all_pts.append(pts)
+        all_a.append(a)
+        all_c.append(col)
+        all_f.append(phi[idx])
+    pts, a = np.concatenate(all_pts), np.concatenate(all_a).astype(np.float64)
+    col, feat = np.concatenate(all_c).astype(np.float64), np.concatenate(all_f).astype(np.float64)
+    ijk = np.floor((pts - np.array(origin)) / res).astype(int)  # eq. 4
+    uniq, inv = np.unique(ijk, axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    assert len(vm) == len(uniq)
+    slots = vm.slots(uniq)
+    assert (slots >= 0).all()
+    np.testing.assert_array_equal(vm.coords[slots], uniq)
+    w = np.bincount(inv, weights=a)  # eq. 8
+    np.testing.assert_allclose(vm.weights[slots], w, rtol=1e-9)
+    for k in range(3):  # eq. 7
+        np.testing.assert_allclose(vm.colors[slots, k], np.bincount(inv, weights=a * col[:, k]) / w, atol=2e-3)
+    fd = np.stack([np.bincount(inv, weights=a * feat[:, k]) / w for k in range(8)], axis=1)  # eq. 6
+    np.testing.assert_allclose(vm.features[slots], fd, atol=1e-4)
+
+
+def test_first_observation_is_stored_unbiased() -> None:
+    vm = VoxelMap(0.05, feature_dim=2)
+    vm.integrate(np.array([[0.01, 0.01, 0.01]]), np.array([0.3]), np.array([[10, 20, 30]], np.uint8),
+                 np.array([0]), np.array([[2.0, -4.0]], np.float32))
+    np.testing.assert_allclose(vm.features[0], [2.0, -4.0])
+    np.testing.assert_allclose(vm.colors[0], [10, 20, 30])
+    assert vm.weights[0] == pytest.approx(0.3)
+
+
+def test_query_and_projection() -> None:
+    rng = np.random.default_rng(0)
+    P = random_projection(64, 16, seed=1)
+    assert P.shape == (64, 16)
+    np.testing.assert_allclose(P.T @ P, np.eye(16) * 4.0, atol=1e-5)
+    vm = VoxelMap(0.1, feature_dim=16, projection=P, text_space="x")
+    a, b = rng.standard_normal(64), rng.standard_normal(64)
+    phi = vm.project(np.stack([a, b]).astype(np.float32))
+    vm.integrate(np.array([[0.05, 0.05, 0.05], [1.05, 0.05, 0.05]]), np.ones(2), np.zeros((2, 3), np.uint8),
+                 np.array([0, 1]), phi)
+    s = vm.query(a)
+    assert s[0] == pytest.approx(1.0, abs=1e-5) and s[1] < 0.6
+    grid = GridSpec(0.0, 0.0, 0.1, 2, 12)
+    top = vm.topdown_scores(a, grid)
+    assert top[0, 0] == pytest.approx(1.0, abs=1e-5) and top[0, 10] == pytest.approx(s[1])
+    assert top[1, 5] == -1.0  # unobserved cells get the lowest cosine
+    with pytest.raises(InputError):
+        vm.query(np.ones(10))
+
+
+def test_occupancy_bands() -> None:
+    vm = VoxelMap(0.05, feature_dim=1)
+    floor = np.array([[x, 0.02, 0.01] for x in np.arange(0.0, 1.0, 0.05)])
+    wall = np.array([[0.52, 0.02, z] for z in (0.3, 1.0)])
+    ceiling = np.array([[0.77, 0.02, 2.4]])
+    pts = np.concatenate([floor, wall, ceiling])
+    vm.integrate(pts, np.ones(len(pts)), np.zeros((len(pts), 3), np.uint8), np.zeros(len(pts), int),
+                 np.zeros((1, 1), np.float32))
+    grid = GridSpec(0.0, 0.0, 0.05, 2, 20)
+    occ = occupancy_from_voxels(vm, OccupancyConfig(), spec=grid)
+    assert occ.cells[0, 10] == OCCUPIED  # wall over floor
+    assert occ.cells[0, 15] == FREE  # ceiling is above the band: floor stays free
+    assert occ.cells[0, 2] == FREE
+    assert (occ.cells[1] == UNKNOWN).all()
+    assert occ.inflated(0.1).cells[0, 12] == OCCUPIED
