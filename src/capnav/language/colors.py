@@ -1,0 +1,249 @@
+"""Colour naming in CIELAB with CIEDE2000, robust to shading.
+
+Why: a caption must say "grey sofa" for a grey sofa whether its points were seen in sunlight or in
+the shadow of a wall. Shading in a renderer or a camera scales linear RGB, which mostly moves
+CIELAB lightness and barely moves hue. So we (1) cluster an object's point colours in Lab (k-means,
+seeded) and keep the dominant clusters, (2) estimate each cluster's unshaded colour from its
+best-lit points (an upper lightness percentile, shading only darkens), and (3) name it with
+CIEDE2000 using ``kL = 2`` (the textile-industry weighting that halves lightness differences).
+
+The lexicon holds common English colour words with typical sRGB values (mostly from the xkcd
+colour-name survey, plus wood tones). Queries use the same lexicon, so "silver" can match an
+object captioned "light grey" by colour distance rather than by exact word.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from capnav.core.errors import InputError
+
+F64 = NDArray[np.float64]
+
+#: Colour word -> typical sRGB. Multi-word names first so that parsing prefers them.
+LEXICON: dict[str, tuple[int, int, int]] = {
+    "light blue": (149, 208, 252),
+    "light grey": (216, 220, 214),
+    "dark grey": (54, 55, 55),
+    "dark brown": (52, 28, 2),
+    "white": (250, 250, 248),
+    "black": (12, 12, 14),
+    "grey": (146, 149, 145),
+    "silver": (197, 201, 199),
+    "cream": (255, 250, 205),
+    "beige": (230, 218, 166),
+    "tan": (209, 178, 111),
+    "brown": (101, 55, 0),
+    "oak": (190, 150, 100),
+    "walnut": (93, 62, 40),
+    "red": (229, 0, 0),
+    "terracotta": (202, 102, 65),
+    "orange": (249, 115, 6),
+    "mustard": (206, 179, 1),
+    "yellow": (255, 230, 20),
+    "olive": (110, 117, 14),
+    "green": (21, 176, 26),
+    "teal": (2, 147, 134),
+    "blue": (3, 67, 223),
+    "navy": (1, 21, 62),
+    "purple": (126, 30, 156),
+    "pink": (255, 129, 192),
+}
+
+#: Spelling variants and near-synonyms a user may type.
+ALIASES: dict[str, str] = {
+    "gray": "grey", "light gray": "light grey", "dark gray": "dark grey", "navy blue": "navy",
+    "off-white": "cream", "off white": "cream", "ivory": "cream", "charcoal": "dark grey",
+    "violet": "purple", "maroon": "red", "crimson": "red", "golden": "mustard", "gold": "mustard",
+    "wooden": "oak", "chrome": "silver", "steel": "silver", "turquoise": "teal", "khaki": "tan",
+}
+
+
+def srgb_to_lab(rgb: NDArray[np.generic]) -> F64:
+    """sRGB (..., 3) in 0..255 -> CIELAB (D65)."""
+    c = np.asarray(rgb, dtype=np.float64) / 255.0
+    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    m = np.array([[0.4124564, 0.3575761, 0.1804375],
+                  [0.2126729, 0.7151522, 0.0721750],
+                  [0.0193339, 0.1191920, 0.9503041]])
+    xyz = lin @ m.T / np.array([0.95047, 1.0, 1.08883])
+    f = np.where(xyz > (6 / 29) ** 3, np.cbrt(xyz), xyz / (3 * (6 / 29) ** 2) + 4 / 29)
+    return np.stack([116 * f[..., 1] - 16, 500 * (f[..., 0] - f[..., 1]), 200 * (f[..., 1] - f[..., 2])], axis=-1)
+
+
+def ciede2000(lab1: NDArray[np.floating], lab2: NDArray[np.floating], kL: float = 1.0, kC: float = 1.0,
+              kH: float = 1.0) -> F64:
+    """CIEDE2000 colour difference between broadcastable Lab arrays (..., 3)."""
+    a, b = np.asarray(lab1, dtype=np.float64), np.asarray(lab2, dtype=np.float64)
+    L1, a1, b1 = a[..., 0], a[..., 1], a[..., 2]
+    L2, a2, b2 = b[..., 0], b[..., 1], b[..., 2]
+    C1, C2 = np.hypot(a1, b1), np.hypot(a2, b2)
+    Cm7 = ((C1 + C2) / 2) ** 7
+    G = 0.5 * (1 - np.sqrt(Cm7 / (Cm7 + 25.0**7)))
+    a1p, a2p = (1 + G) * a1, (1 + G) * a2
+    C1p, C2p = np.hypot(a1p, b1), np.hypot(a2p, b2)
+    h1p = np.degrees(np.arctan2(b1, a1p)) % 360
+    h2p = np.degrees(np.arctan2(b2, a2p)) % 360
+    dLp = L2 - L1
+    dCp = C2p - C1p
+    dh = h2p - h1p
+    dh = np.where(dh > 180, dh - 360, np.where(dh < -180, dh + 360, dh))
+    dh = np.where(C1p * C2p == 0, 0.0, dh)
+    dHp = 2 * np.sqrt(C1p * C2p) * np.sin(np.radians(dh) / 2)
+    Lpm = (L1 + L2) / 2
+    Cpm = (C1p + C2p) / 2
+    hsum = h1p + h2p
+    hpm = np.where(np.abs(h1p - h2p) > 180, np.where(hsum < 360, (hsum + 360) / 2, (hsum - 360) / 2), hsum / 2)
+    hpm = np.where(C1p * C2p == 0, hsum, hpm)
+    T = (1 - 0.17 * np.cos(np.radians(hpm - 30)) + 0.24 * np.cos(np.radians(2 * hpm))
+         + 0.32 * np.cos(np.radians(3 * hpm + 6)) - 0.20 * np.cos(np.radians(4 * hpm - 63)))
+    dtheta = 30 * np.exp(-(((hpm - 275) / 25) ** 2))
+    Cpm7 = Cpm**7
+    RC = 2 * np.sqrt(Cpm7 / (Cpm7 + 25.0**7))
+    SL = 1 + 0.015 * (Lpm - 50) ** 2 / np.sqrt(20 + (Lpm - 50) ** 2)
+    SC = 1 + 0.045 * Cpm
+    SH = 1 + 0.015 * Cpm * T
+    RT = -np.sin(np.radians(2 * dtheta)) * RC
+    tL, tC, tH = dLp / (kL * SL), dCp / (kC * SC), dHp / (kH * SH)
+    return np.asarray(np.sqrt(tL**2 + tC**2 + tH**2 + RT * tC * tH), dtype=np.float64)
+
+
+NAMES: tuple[str, ...] = tuple(LEXICON)
+LEX_LAB: F64 = srgb_to_lab(np.array([LEXICON[n] for n in NAMES]))
+
+
+def canonical_color(word: str) -> str | None:
+    """Lexicon name of a colour word or alias (``gray`` -> ``grey``), else None."""
+    w = word.strip().lower()
+    if w in LEXICON:
+        return w
+    return ALIASES.get(w)
+
+
+def name_lab(lab: NDArray[np.floating], kL: float = 2.0) -> tuple[str, float]:
+    """Nearest lexicon colour of one Lab colour and its CIEDE2000 distance."""
+    d = ciede2000(np.asarray(lab, dtype=np.float64)[None, :], LEX_LAB, kL=kL)
+    i = int(np.argmin(d))
+    return NAMES[i], float(d[i])
+
+
+@dataclass(frozen=True)
+class ColorCluster:
+    name: str
+    lab: tuple[float, float, float]  # estimated unshaded colour
+    fraction: float  # share of the object's points
+    distance: float  # CIEDE2000 to the named colour
+
+
+@dataclass(frozen=True)
+class ColorConfig:
+    max_clusters: int = 3
+    max_points: int = 4000  # subsample for speed
+    iterations: int = 12
+    lit_percentile: float = 85.0  # shading only darkens: best-lit points approximate the albedo
+    min_fraction: float = 0.12  # clusters smaller than this are not reported
+    kL: float = 2.0
+    luminance_weight: float = 0.04  # chromaticity units per e-fold of luminance
+    merge_distance: float = 0.05  # k-means clusters closer than this are one surface (lit + shaded)
+    seed: int = 0
+
+
+def _shading_invariant_features(rgb: NDArray[np.generic], luminance_weight: float) -> F64:
+    """Chromaticity of linear RGB (unchanged when shading scales the light) plus a weak
+    log-luminance term, so that white and black parts still separate but lit and shaded faces
+    of one surface do not."""
+    c = np.asarray(rgb, dtype=np.float64) / 255.0
+    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4) + 1e-3
+    s = lin.sum(axis=1, keepdims=True)
+    chroma = lin[:, :2] / s
+    y = np.log(lin @ np.array([0.2126, 0.7152, 0.0722]))
+    return np.concatenate([chroma, luminance_weight * y[:, None]], axis=1)
+
+
+def _merge_close(feats: F64, labels: NDArray[np.intp], dist: float) -> NDArray[np.intp]:
+    """Single-linkage merge of cluster centres closer than ``dist`` (k-means splits a uniformly
+    coloured but unevenly lit surface along luminance)."""
+    ids = list(np.unique(labels))
+    centers = {j: feats[labels == j].mean(0) for j in ids}
+    parent = {j: j for j in ids}
+
+    def root(j: int) -> int:
+        while parent[j] != j:
+            j = parent[j]
+        return j
+
+    for i, a in enumerate(ids):
+        for b in ids[i + 1:]:
+            if np.linalg.norm(centers[a] - centers[b]) < dist:
+                parent[root(b)] = root(a)
+    return np.array([root(int(j)) for j in labels], dtype=np.intp)
+
+
+def _kmeans(x: F64, k: int, iters: int, rng: np.random.Generator) -> NDArray[np.intp]:
+    """Plain k-means with k-means++ seeding."""
+    centers = [x[rng.integers(len(x))]]
+    for _ in range(1, k):
+        d2 = np.min(((x[:, None, :] - np.array(centers)[None]) ** 2).sum(-1), axis=1)
+        if d2.sum() <= 0:
+            break
+        centers.append(x[rng.choice(len(x), p=d2 / d2.sum())])
+    c = np.array(centers)
+    labels = np.zeros(len(x), dtype=np.intp)
+    for _ in range(iters):
+        labels = np.argmin(((x[:, None, :] - c[None]) ** 2).sum(-1), axis=1)
+        new = np.array([x[labels == j].mean(0) if np.any(labels == j) else c[j] for j in range(len(c))])
+        if np.allclose(new, c):
+            break
+        c = new
+    return labels
+
+
+def object_colors(rgb: NDArray[np.generic], config: ColorConfig | None = None) -> list[ColorCluster]:
+    """Dominant named colours of an object's point colours (N, 3) uint8, largest share first."""
+    cfg = config or ColorConfig()
+    rgb = np.asarray(rgb)
+    if rgb.ndim != 2 or rgb.shape[1] != 3:
+        raise InputError(f"colours must be (N, 3), got {rgb.shape}")
+    if len(rgb) == 0:
+        return []
+    rng = np.random.default_rng(cfg.seed)
+    if len(rgb) > cfg.max_points:
+        rgb = rgb[np.sort(rng.choice(len(rgb), cfg.max_points, replace=False))]
+    lab = srgb_to_lab(rgb)
+    feats = _shading_invariant_features(rgb, cfg.luminance_weight)
+    k = int(min(cfg.max_clusters, max(1, len(lab) // 20)))
+    labels = _kmeans(feats, k, cfg.iterations, rng) if k > 1 else np.zeros(len(lab), dtype=np.intp)
+    labels = _merge_close(feats, labels, cfg.merge_distance)
+    out: list[ColorCluster] = []
+    for j in np.unique(labels):
+        members = lab[labels == j]
+        frac = len(members) / len(lab)
+        if frac < cfg.min_fraction and out:
+            continue
+        cut = np.percentile(members[:, 0], cfg.lit_percentile)
+        lit = members[members[:, 0] >= cut - 1e-9].mean(axis=0)
+        name, dist = name_lab(lit, kL=cfg.kL)
+        out.append(ColorCluster(name, (float(lit[0]), float(lit[1]), float(lit[2])), float(frac), dist))
+    out.sort(key=lambda c: -c.fraction)
+    # Merge clusters that received the same name.
+    merged: dict[str, ColorCluster] = {}
+    for c in out:
+        if c.name in merged:
+            m = merged[c.name]
+            merged[c.name] = ColorCluster(m.name, m.lab, m.fraction + c.fraction, m.distance)
+        else:
+            merged[c.name] = c
+    return sorted(merged.values(), key=lambda c: -c.fraction)
+
+
+def color_agreement(word: str, lab: NDArray[np.floating] | tuple[float, float, float], scale: float = 12.0,
+                    kL: float = 2.0) -> float:
+    """How well a colour word fits a measured colour, in (0, 1]: exp(-ΔE00 / scale)."""
+    name = canonical_color(word)
+    if name is None:
+        raise InputError(f"unknown colour word {word!r}")
+    d = float(ciede2000(LEX_LAB[NAMES.index(name)], np.asarray(lab, dtype=np.float64), kL=kL))
+    return float(np.exp(-d / scale))

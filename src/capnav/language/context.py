@@ -1,0 +1,167 @@
+"""What the map itself says about an object's surroundings: neighbours, relative size and the room.
+
+Room names are never observed, so a room is inferred from characteristic objects seen nearby
+(fridge / stove / counter -> kitchen, bed -> bedroom, toilet / bathtub -> bathroom, sofa / TV ->
+living room, desk -> office), weighted by distance and counted only when no wall lies between the
+two objects. Walls are occupied cells of the top-down grid that no object's box covers, so
+furniture standing between two objects does not hide them from each other.
+Used by the offline captioner ("next to the bed", "in the kitchen") and by retrieval predicates.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from capnav.core.categories import NAMES, category
+from capnav.core.errors import InputError
+from capnav.core.grid import OCCUPIED, OccupancyGrid
+from capnav.mapping.objects import MapObject
+
+#: Characteristic objects per room type and how strongly each one implies the room.
+ROOM_CUES: dict[str, dict[str, float]] = {
+    "kitchen": {"refrigerator": 1.0, "stove": 1.0, "counter": 0.9, "washing machine": 0.3},
+    "bedroom": {"bed": 1.0, "nightstand": 0.7, "wardrobe": 0.5, "dresser": 0.5},
+    "bathroom": {"toilet": 1.0, "bathtub": 1.0, "sink": 0.6, "washing machine": 0.3},
+    "living room": {"sofa": 1.0, "tv": 0.8, "coffee table": 0.8, "armchair": 0.5},
+    "office": {"desk": 1.0, "bookshelf": 0.4},
+}
+ROOM_SYNONYMS: dict[str, str] = {
+    "kitchen": "kitchen", "bedroom": "bedroom", "bed room": "bedroom", "master bedroom": "bedroom",
+    "bathroom": "bathroom", "bath room": "bathroom", "restroom": "bathroom", "washroom": "bathroom",
+    "living room": "living room", "lounge": "living room", "sitting room": "living room",
+    "living area": "living room", "family room": "living room",
+    "office": "office", "study": "office", "home office": "office", "workroom": "office",
+}
+
+
+@dataclass(frozen=True)
+class ContextConfig:
+    next_to_distance: float = 1.2  # m between footprints for "next to"
+    room_sigma: float = 2.5  # m, Gaussian fall-off of a room cue
+    room_min_score: float = 0.35  # below this the room stays unknown
+    wall_cells: int = 1  # occupied non-object cells on a segment that count as a wall
+    object_margin: float = 0.15  # m around object boxes not counted as wall
+
+
+def canonical_label(label: str) -> str:
+    """A category name canonicalised through the vocabulary's synonyms, else as given."""
+    try:
+        return category(label).name
+    except InputError:
+        return label.strip().lower()
+
+
+def label_of(obj: MapObject) -> str:
+    return canonical_label(obj.label)
+
+
+@dataclass
+class SceneContext:
+    """Spatial relations between all objects of a map, computed once (vectorised)."""
+
+    objects: list[MapObject]
+    occupancy: OccupancyGrid | None = None
+    config: ContextConfig = field(default_factory=ContextConfig)
+
+    def __post_init__(self) -> None:
+        n = len(self.objects)
+        self.labels = [label_of(o) for o in self.objects]
+        self.index = {o.id: i for i, o in enumerate(self.objects)}
+        self.lo = np.array([o.extent_min[:2] for o in self.objects], dtype=np.float64).reshape(n, 2)
+        self.hi = np.array([o.extent_max[:2] for o in self.objects], dtype=np.float64).reshape(n, 2)
+        self.xy = np.array([o.position[:2] for o in self.objects], dtype=np.float64).reshape(n, 2)
+        size = np.array([o.size for o in self.objects], dtype=np.float64).reshape(n, 3)
+        self.volume = np.prod(np.maximum(size, 0.02), axis=1)
+        # Box-to-box gap in the floor plane (0 when boxes touch or overlap).
+        gap = np.maximum(0.0, np.maximum(self.lo[:, None] - self.hi[None], self.lo[None] - self.hi[:, None]))
+        self.gap = np.hypot(gap[..., 0], gap[..., 1])
+        self.visible = self._line_of_sight()
+        self.rooms = [self._room(i) for i in range(n)]
+
+    # -- walls ---------------------------------------------------------------------------------
+    def _wall_mask(self) -> NDArray[np.bool_] | None:
+        if self.occupancy is None:
+            return None
+        spec = self.occupancy.spec
+        wall = self.occupancy.cells == OCCUPIED
+        m = self.config.object_margin
+        for lo, hi in zip(self.lo, self.hi, strict=True):
+            r0, c0 = spec.to_cell(lo - m)
+            r1, c1 = spec.to_cell(hi + m)
+            wall[max(r0, 0):max(r1 + 1, 0), max(c0, 0):max(c1 + 1, 0)] = False
+        return wall
+
+    def _line_of_sight(self) -> NDArray[np.bool_]:
+        n = len(self.objects)
+        vis = np.ones((n, n), dtype=bool)
+        wall = self._wall_mask()
+        if wall is None or n < 2 or self.occupancy is None:
+            return vis
+        spec = self.occupancy.spec
+        ii, jj = np.triu_indices(n, k=1)
+        steps = max(2, int(np.ceil(float(np.max(np.linalg.norm(self.xy[ii] - self.xy[jj], axis=1))) / spec.resolution)))
+        t = np.linspace(0.0, 1.0, steps)[None, :, None]
+        chunk = max(1, 2_000_000 // steps)  # bound the (pairs, steps, 2) temporary
+        for s in range(0, len(ii), chunk):
+            i, j = ii[s:s + chunk], jj[s:s + chunk]
+            pts = self.xy[i][:, None, :] * (1 - t) + self.xy[j][:, None, :] * t
+            rc = spec.to_cell(pts)
+            inside = spec.inside(rc)
+            rr = np.clip(rc[..., 0], 0, spec.rows - 1)
+            cc = np.clip(rc[..., 1], 0, spec.cols - 1)
+            blocked = (wall[rr, cc] & inside).sum(axis=1) >= self.config.wall_cells
+            vis[i[blocked], j[blocked]] = False
+            vis[j[blocked], i[blocked]] = False
+        return vis
+
+    # -- rooms ---------------------------------------------------------------------------------
+    def room_scores(self, i: int) -> dict[str, float]:
+        d = np.linalg.norm(self.xy - self.xy[i], axis=1)
+        w = np.exp(-0.5 * (d / self.config.room_sigma) ** 2) * self.visible[i]
+        scores: dict[str, float] = {}
+        for room, cues in ROOM_CUES.items():
+            s = 0.0
+            for k, lab in enumerate(self.labels):
+                if lab in cues:
+                    s += cues[lab] * float(w[k])
+            scores[room] = s
+        return scores
+
+    def _room(self, i: int) -> str | None:
+        scores = self.room_scores(i)
+        room, best = max(scores.items(), key=lambda kv: kv[1])
+        return room if best >= self.config.room_min_score else None
+
+    def room_of(self, obj: MapObject) -> str | None:
+        return self.rooms[self.index[obj.id]]
+
+    # -- neighbours and sizes ------------------------------------------------------------------
+    def neighbours(self, obj: MapObject, max_gap: float | None = None) -> list[tuple[MapObject, float]]:
+        """Other-category objects whose boxes lie within ``max_gap`` m, nearest first, visible only."""
+        i = self.index[obj.id]
+        lim = self.config.next_to_distance if max_gap is None else max_gap
+        cand = [(k, float(self.gap[i, k])) for k in range(len(self.objects))
+                if k != i and self.labels[k] != self.labels[i] and self.gap[i, k] <= lim and self.visible[i, k]]
+        cand.sort(key=lambda kv: (kv[1], float(np.linalg.norm(self.xy[kv[0]] - self.xy[i]))))
+        return [(self.objects[k], g) for k, g in cand]
+
+    def same_label(self, obj: MapObject) -> list[MapObject]:
+        lab = self.labels[self.index[obj.id]]
+        return [o for o, lb in zip(self.objects, self.labels, strict=True) if lb == lab]
+
+    def size_rank(self, obj: MapObject) -> tuple[int, int]:
+        """(rank, count) of the object's volume among its category, rank 0 = largest."""
+        peers = self.same_label(obj)
+        vols = sorted((-self.volume[self.index[o.id]], o.id) for o in peers)
+        order = [oid for _, oid in vols]
+        return order.index(obj.id), len(peers)
+
+
+def canonical_room(text: str) -> str | None:
+    return ROOM_SYNONYMS.get(text.strip().lower())
+
+
+__all__ = ["NAMES", "ROOM_CUES", "ContextConfig", "SceneContext", "canonical_label", "canonical_room", "label_of"]

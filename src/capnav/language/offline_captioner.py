@@ -1,0 +1,192 @@
+"""The offline default captioner: the paper's caption schema written from what the map observed.
+
+Nothing here reads the scene manifest. The category comes from the object's label votes (the
+detector's hint may be wrong, so the vote winner is used, not the last label); colours from its
+fused point colours, or from its views' pixels when it has few points (``colors.object_colors``);
+size in metres and relative to the other instances of its category; shape cues from its
+top-down footprint; neighbours and room from ``SceneContext``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from capnav.language.captioner import CAPTIONERS, Caption, Captioner
+from capnav.language.colors import ColorCluster, ColorConfig, object_colors
+from capnav.language.context import SceneContext, canonical_label, label_of
+from capnav.language.prompts import MAX_CAPTION_WORDS
+from capnav.mapping.objects import MapObject
+
+_COUNT = {2: "two", 3: "three", 4: "four", 5: "five", 6: "six", 7: "seven", 8: "eight"}
+_PLURAL = {"shelf": "shelves", "bookshelf": "bookshelves", "bench": "benches", "tv": "TVs", "couch": "couches",
+           "washing machine": "washing machines", "sofa": "sofas", "bathtub": "bathtubs"}
+
+
+def plural(word: str) -> str:
+    if word in _PLURAL:
+        return _PLURAL[word]
+    if word.endswith(("s", "x", "ch", "sh")):
+        return word + "es"
+    return word + "s"
+
+
+@dataclass(frozen=True)
+class OfflineCaptionConfig:
+    colors: ColorConfig = field(default_factory=ColorConfig)
+    second_color_fraction: float = 0.25  # report a second colour when it covers this share
+    min_points: int = 30  # fewer fused points than this: use the views' pixels for colour
+    round_circularity: float = 0.86  # 4*pi*A/P^2 of the footprint hull (square: 0.785)
+    l_shape_fill: float = 0.72  # occupied share of the footprint hull below which it is L-shaped
+    long_aspect: float = 2.3
+
+
+def vote_label(obj: MapObject) -> str:
+    """Category by label votes (accumulated confidence), falling back to the current label."""
+    if obj.label_votes:
+        return canonical_label(max(sorted(obj.label_votes.items()), key=lambda kv: kv[1])[0])
+    return label_of(obj)
+
+
+def view_pixels(obj: MapObject, max_views: int = 5) -> NDArray[np.uint8]:
+    """RGB pixels of the central half of each view's crop (the object, not its margin)."""
+    from PIL import Image
+
+    chunks = []
+    for v in obj.views[:max_views]:
+        if not v.crop_png:
+            continue
+        img = np.asarray(Image.open(io.BytesIO(v.crop_png)).convert("RGB"))
+        h, w = img.shape[:2]
+        chunks.append(img[h // 4: max(h // 4 + 1, 3 * h // 4), w // 4: max(w // 4 + 1, 3 * w // 4)].reshape(-1, 3))
+    return np.concatenate(chunks) if chunks else np.zeros((0, 3), dtype=np.uint8)
+
+
+def footprint_shape(obj: MapObject, cfg: OfflineCaptionConfig) -> str | None:
+    """"round", "L-shaped" or "long" from the top-down point footprint, else None."""
+    pts = np.asarray(obj.points, dtype=np.float64)
+    if len(pts) < 40:
+        return None
+    from scipy.spatial import ConvexHull, QhullError
+
+    xy = pts[:, :2]
+    try:
+        hull = ConvexHull(xy)
+    except (QhullError, ValueError):
+        return None
+    area, perim = float(hull.volume), float(hull.area)
+    if area < 0.02:
+        return None
+    res = max(0.04, np.sqrt(area / 400.0))
+    cells = np.unique(np.floor(xy / res).astype(np.int64), axis=0)
+    occ = len(cells) * res * res / area
+    centered = xy - xy.mean(0)
+    ev = np.linalg.eigvalsh(np.cov(centered.T))
+    aspect = float(np.sqrt(max(ev[1], 1e-9) / max(ev[0], 1e-9)))
+    if occ < cfg.l_shape_fill and aspect < 2.0:
+        return "L-shaped"
+    if 4 * np.pi * area / perim**2 >= cfg.round_circularity and aspect < 1.25:
+        return "round"
+    if aspect >= cfg.long_aspect:
+        return "long"
+    return None
+
+
+class ObservationCaptioner(Captioner):
+    """Writes "NAME, one sentence" from the map's observations (no model, deterministic)."""
+
+    model_id = "offline-observation-v1"
+
+    def __init__(self, config: OfflineCaptionConfig | None = None) -> None:
+        self.config = config or OfflineCaptionConfig()
+
+    def colors(self, obj: MapObject) -> list[ColorCluster]:
+        rgb = np.asarray(obj.colors)
+        if len(rgb) < self.config.min_points:
+            px = view_pixels(obj)
+            if len(px) > len(rgb):
+                rgb = px
+        return object_colors(rgb.reshape(-1, 3), self.config.colors) if len(rgb) else []
+
+    def color_phrase(self, obj: MapObject) -> str | None:
+        cols = self.colors(obj)
+        if not cols:
+            return None
+        if len(cols) > 1 and cols[1].fraction >= self.config.second_color_fraction:
+            return f"{cols[0].name} and {cols[1].name}"
+        return cols[0].name
+
+    def parts(self, obj: MapObject, scene: SceneContext) -> dict[str, str]:
+        """The caption's pieces by role (also used by tests and explanations)."""
+        name = vote_label(obj)
+        out: dict[str, str] = {"name": name}
+        color = self.color_phrase(obj)
+        if color:
+            out["color"] = color
+        size = obj.size
+        out["width"] = f"{max(float(size[0]), float(size[1])):.1f} m wide"
+        out["height"] = f"{float(size[2]):.1f} m tall"
+        shape = footprint_shape(obj, self.config)
+        if shape:
+            out["shape"] = shape
+        if obj.id in scene.index:
+            rank, count = scene.size_rank(obj)
+            if count == 2:
+                out["relative"] = f"the {'larger' if rank == 0 else 'smaller'} of the two {plural(name)}"
+                out["size"] = "large" if rank == 0 else "small"
+            elif count > 2 and rank in (0, count - 1):
+                word = "largest" if rank == 0 else "smallest"
+                out["relative"] = f"the {word} of {_COUNT.get(count, str(count))} {plural(name)}"
+                out["size"] = "large" if rank == 0 else "small"
+            near = scene.neighbours(obj)
+            if near:
+                out["near"] = f"next to the {label_of(near[0][0])}"
+            room = scene.room_of(obj)
+            if room:
+                out["room"] = f"in the {room}"
+        return out
+
+    def compose(self, p: dict[str, str]) -> str:
+        """"NAME, a <size> <colour> <shape> <name>, W m wide and H m tall, <relative>, <near> <room>."
+        Optional clauses are dropped (relative size first) until the sentence fits 25 words."""
+        adjs = " ".join(x for x in (p.get("size"), p.get("color"), p.get("shape")) if x)
+        head = f"{adjs} {p['name']}" if adjs else p["name"]
+        head = ("an " if head[0] in "aeiouAEIOU" else "a ") + head
+        optional = [k for k in ("relative", "near", "room") if k in p]
+        while True:
+            parts = [f"{head}, {p['width']} and {p['height']}"]
+            if "relative" in optional:
+                parts.append(p["relative"])
+            tail = " ".join(p[k] for k in ("near", "room") if k in optional)
+            if tail:
+                parts.append(tail)
+            sentence = ", ".join(parts)
+            if len(sentence.split()) <= MAX_CAPTION_WORDS or not optional:
+                return f"{p['name'].upper()}, {sentence}."
+            optional.pop(0)
+
+    def caption(self, obj: MapObject, scene: SceneContext) -> Caption:
+        return Caption(self.compose(self.parts(obj, scene)), self.model_id)
+
+    def cache_key(self, obj: MapObject, scene: SceneContext) -> str:
+        """The offline caption depends on the observations and the neighbours, not on pixels only."""
+        h = hashlib.sha256(self.model_id.encode())
+        h.update(repr(sorted(obj.label_votes.items())).encode())
+        h.update(np.ascontiguousarray(obj.colors).tobytes())
+        h.update(np.ascontiguousarray(obj.points).tobytes())
+        for v in obj.views:
+            h.update(hashlib.sha256(v.crop_png).digest())
+        if obj.id in scene.index:
+            i = scene.index[obj.id]
+            h.update(repr((scene.rooms[i], scene.size_rank(obj), [o.id for o, _ in scene.neighbours(obj)][:1],
+                           len(scene.objects))).encode())
+        return h.hexdigest()
+
+
+@CAPTIONERS.register("offline")
+def offline(**kwargs: object) -> ObservationCaptioner:
+    return ObservationCaptioner(**kwargs)  # type: ignore[arg-type]
