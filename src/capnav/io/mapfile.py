@@ -152,8 +152,8 @@ class _Reader:
             raise self.fail(f"entry {name!r} is missing (truncated file?)") from None
         except (zipfile.BadZipFile, zlib.error, EOFError, OSError) as e:
             raise self.fail(f"entry {name!r} is unreadable ({e}); the file is corrupt or truncated") from None
-        e = self.entries[name]
-        if len(data) != e.get("bytes") or hashlib.sha256(data).hexdigest() != e.get("sha256"):
+        ent = self.entries[name]
+        if len(data) != ent.get("bytes") or hashlib.sha256(data).hexdigest() != ent.get("sha256"):
             raise self.fail(f"entry {name!r} fails its sha256 checksum (corrupted)")
         return data
 
@@ -169,10 +169,10 @@ class _Reader:
             arr = np.load(io.BytesIO(data), allow_pickle=False)
         except (ValueError, OSError) as e:
             raise self.fail(f"array {name!r} is not a valid .npy without pickles ({e})") from None
-        e = self.entries[name]
-        if arr.dtype.str != e.get("dtype") or list(arr.shape) != e.get("shape"):
+        ent = self.entries[name]
+        if arr.dtype.str != ent.get("dtype") or list(arr.shape) != ent.get("shape"):
             raise self.fail(f"array {name!r} is {arr.dtype.str} {list(arr.shape)}, header says "
-                            f"{e.get('dtype')} {e.get('shape')}")
+                            f"{ent.get('dtype')} {ent.get('shape')}")
         return arr
 
 
