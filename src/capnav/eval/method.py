@@ -23,14 +23,14 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 from capnav.core.registry import Registry
 
 if TYPE_CHECKING:
+    from capnav.core.grid import OccupancyGrid
     from capnav.language.embedder import TextEmbedder
+    from capnav.mapping.cmap import CapNavMap
+    from capnav.perception.base import Detector
 
-# The simulator / mapping / perception / dataset types are owned by other stages; the harness
-# only needs them to be passed through, so they are typed loosely here and documented.
-Simulator = Any  # capnav.sim: spawn_agent(x, y, yaw), random_navigable_point(rng), geodesic_distance
-Agent = Any  # capnav.sim agent: pose, step / move_to, observe(), path_length
-CapNavMap = Any  # capnav.mapping: objects, voxels, occupancy
-Detector = Any  # capnav.perception detector
+# The simulator and dataset types are passed through untouched; typed loosely and documented.
+Simulator = Any  # capnav.sim simulator: spawn_agent(x, y, yaw) -> Agent, observe
+Agent = Any  # capnav.sim agent: pose (x, y, yaw), step(action), move_to(x, y), trajectory, path_length
 DatasetReader = Any  # capnav.io.dataset reader of the shared exploration stream
 
 
@@ -50,7 +50,7 @@ class SceneContext:
     embedder: TextEmbedder
     detector: Detector | None = None
     prior_map: CapNavMap | None = None
-    occupancy: Any | None = None  # capnav.core.grid.OccupancyGrid of the prior map
+    occupancy: OccupancyGrid | None = None  # navigable top-down grid of the prior map
     frames: DatasetReader | None = None
     workdir: Path | None = None  # a per-apartment scratch folder the method may write caches to
     max_steps: int = 500  # motion budget per subgoal (agent steps)

@@ -1,0 +1,96 @@
+"""Run one method through one episode and score every subgoal against the ground truth.
+
+The harness, not the method, measures what counts: where the agent stopped (from its pose), how
+far it drove in this subgoal (from its odometry), whether that is within 1 m of a goal footprint,
+the geodesic shortest path for SPL, and whether the method's chosen target was the right instance.
+Each subgoal starts where the previous one stopped.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from capnav.core.errors import CapNavError
+from capnav.eval.episodes import Episode
+from capnav.eval.generate import SceneTruth
+from capnav.eval.method import NavMethod, SceneContext, SubgoalOutcome
+from capnav.eval.metrics import SubgoalRecord
+from capnav.eval.success import distance_to_instances
+
+#: A chosen target counts as the right instance when it lies this close to the instance's footprint
+#: (map centroids of large objects sit inside their footprint; small ones within a few decimetres).
+RETRIEVAL_TOLERANCE_M = 0.5
+
+
+def _xy(agent: Any) -> tuple[float, float]:
+    p = agent.pose
+    return float(p[0]), float(p[1])
+
+
+def _trajectory(agent: Any) -> list[tuple[float, float]]:
+    traj = getattr(agent, "trajectory", None)
+    return [] if traj is None else [(float(p[0]), float(p[1])) for p in traj]
+
+
+def _odometry(agent: Any) -> float:
+    """Distance the agent has driven since it was spawned (its own counter, else its trajectory)."""
+    pl = getattr(agent, "path_length", None)
+    if pl is not None:
+        return float(pl() if callable(pl) else pl)
+    t = np.asarray(_trajectory(agent), dtype=np.float64).reshape(-1, 2)
+    return float(np.linalg.norm(np.diff(t, axis=0), axis=1).sum()) if len(t) > 1 else 0.0
+
+
+def retrieval_correct(truth: SceneTruth, target_xy: tuple[float, float] | None, target_ids: list[int]) -> bool | None:
+    """Is the method's chosen target at a goal instance, and nearer to it than to any other instance?
+
+    None when the method chose no target (it then counts as wrong in the top-1 rate)."""
+    if target_xy is None:
+        return None
+    d_goal = distance_to_instances(target_xy, [truth.footprints[i] for i in target_ids])
+    others = [f for i, f in truth.footprints.items() if i not in target_ids]
+    d_other = distance_to_instances(target_xy, others)
+    return bool(d_goal <= RETRIEVAL_TOLERANCE_M and d_goal <= d_other)
+
+
+def run_episode(method: NavMethod, ctx: SceneContext, episode: Episode, truth: SceneTruth, protocol: str
+                ) -> list[SubgoalRecord]:
+    """Spawn the agent at the episode's start, run the subgoals in order, score each."""
+    s = episode.start
+    agent = ctx.sim.spawn_agent(s.x, s.y, s.yaw)
+    method.start_episode(ctx, agent)
+    records: list[SubgoalRecord] = []
+    for i, goal in enumerate(episode.subgoals):
+        start_xy = _xy(agent)
+        odo0, traj0 = _odometry(agent), len(_trajectory(agent))
+        t0 = time.perf_counter()
+        try:
+            out = method.run_subgoal(goal.text, agent)
+        except CapNavError as e:  # an expected failure (unreachable goal, nothing found): the agent stays put
+            out = SubgoalOutcome(found=False, reason=f"{type(e).__name__}: {e}",
+                                 query_time_s=time.perf_counter() - t0)
+        stop_xy = _xy(agent)
+        footprints = [truth.footprints[t] for t in goal.target_ids]
+        dist = distance_to_instances(stop_xy, footprints)
+        traj = _trajectory(agent)[max(traj0 - 1, 0):] or [start_xy, stop_xy]
+        records.append(SubgoalRecord(
+            method=method.name, protocol=protocol, scene_seed=episode.scene_seed, episode_id=episode.id, index=i,
+            text=goal.text, category=goal.category, target_ids=list(goal.target_ids), kind=goal.kind,
+            success=bool(dist <= truth.radius), distance_to_goal=dist,
+            path_length=max(_odometry(agent) - odo0, 0.0),
+            shortest_path=truth.field(goal.target_ids).at(start_xy),
+            start_xy=start_xy, stop_xy=stop_xy, found=bool(out.found),
+            retrieval_correct=retrieval_correct(truth, out.target_xy, goal.target_ids),
+            query_time_s=float(out.query_time_s), steps=int(out.steps), reason=out.reason,
+            target_xy=None if out.target_xy is None else (float(out.target_xy[0]), float(out.target_xy[1])),
+            chosen_object=out.chosen_object, explanation=out.explanation,
+            trajectory=[(round(x, 3), round(y, 3)) for x, y in traj]))
+    return records
+
+
+def finite_or_none(x: float) -> float | None:
+    return x if math.isfinite(x) else None
