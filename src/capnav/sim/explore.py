@@ -1,0 +1,159 @@
+"""A virtual exploration pass (the paper's posed RGB-D collection): visit every room, look around at
+a few spots, look at every object from several distances, walk between stops on shortest paths.
+
+The policy reads the scene truth to choose viewpoints (it is part of the simulator, like a scripted
+data-collection run); the frames it yields are plain observations.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from capnav.core.errors import InputError
+from capnav.core.frame import Frame
+from capnav.core.geometry import look_at_pose
+from capnav.sim.simulator import Simulator
+
+
+@dataclass(frozen=True)
+class ExploreConfig:
+    """Exploration policy knobs; the defaults give about 200-400 frames per apartment."""
+
+    seed: int = 0
+    turn_deg: float = 30.0  # rotation step when looking around at a spot
+    look_pitches_deg: tuple[float, float] = (8.0, 30.0)  # alternated while looking around
+    spot_area: float = 12.0  # one look-around spot per this many m² of room (1..3 per room)
+    view_distances: tuple[float, ...] = (1.3, 2.3)  # one view of every object per distance
+    travel_step: float = 0.5  # a frame every this many metres while walking
+    travel_pitch_deg: float = 12.0
+    stride: int = 1  # keep every stride-th frame
+    max_frames: int | None = None  # subsample uniformly to at most this many frames
+
+    def __post_init__(self) -> None:
+        if self.stride < 1:
+            raise InputError(f"stride must be >= 1, got {self.stride}")
+        if self.max_frames is not None and self.max_frames < 1:
+            raise InputError(f"max_frames must be >= 1, got {self.max_frames}")
+        if not (5.0 <= self.turn_deg <= 180.0) or self.travel_step <= 0:
+            raise InputError("turn_deg must be in [5, 180] and travel_step > 0")
+
+
+def plan_exploration(sim: Simulator, cfg: ExploreConfig) -> list[NDArray[np.float64]]:
+    """Camera poses (T_wc) of the whole pass, in order; deterministic given the scene and ``cfg.seed``."""
+    rng = np.random.default_rng([cfg.seed, sim.seed, 7])
+    grid = sim.nav_grid()
+    pts = grid.free_points()
+    apt = sim.apartment
+    cam_h = sim.config.agent.camera_height
+    order = _room_order(sim)
+    poses: list[NDArray[np.float64]] = []
+    pos: NDArray[np.float64] | None = None
+    for k in order:
+        r = apt.plan.rooms[k]
+        inroom = pts[(pts[:, 0] > r.x0) & (pts[:, 0] < r.x1) & (pts[:, 1] > r.y0) & (pts[:, 1] < r.y1)]
+        if len(inroom) == 0:
+            continue
+        # stops: (x, y, look) where look is None for a look-around, or the (x, y, z) to look at
+        stops: list[tuple[float, float, tuple[float, float, float] | None]] = []
+        for s in _spread_points(inroom, grid, max(1, min(3, round(r.area / cfg.spot_area))), rng):
+            stops.append((float(s[0]), float(s[1]), None))
+        for o in (o for o in apt.objects if o.room == k):
+            target = (o.x, o.y, min(o.model.size[2] * 0.6, cam_h))
+            d = np.hypot(inroom[:, 0] - o.x, inroom[:, 1] - o.y)
+            for dist in cfg.view_distances:
+                near = np.flatnonzero(np.abs(d - dist) < 0.35)
+                if len(near) == 0:
+                    near = np.array([int(np.argmin(np.abs(d - dist)))])
+                p = inroom[int(near[int(rng.integers(len(near)))])]
+                stops.append((float(p[0]), float(p[1]), target))
+        # visit stops nearest-first from where we are
+        remaining = list(range(len(stops)))
+        while remaining:
+            j = 0
+            if pos is not None:
+                here = pos
+                j = min(range(len(remaining)), key=lambda i: math.hypot(stops[remaining[i]][0] - here[0],
+                                                                       stops[remaining[i]][1] - here[1]))
+            x, y, look = stops[remaining.pop(j)]
+            if pos is not None:
+                poses += _walk(sim, pos, np.array([x, y]), cfg)
+            pos = np.array([x, y])
+            eye = np.array([x, y, cam_h])
+            if look is None:
+                n = round(360.0 / cfg.turn_deg)
+                yaw0 = float(rng.uniform(-math.pi, math.pi))
+                for i in range(n):
+                    pitch = math.radians(cfg.look_pitches_deg[i % len(cfg.look_pitches_deg)])
+                    poses.append(look_at_pose(eye, yaw0 + i * math.radians(cfg.turn_deg), pitch))
+            else:
+                dx, dy, dz = look[0] - x, look[1] - y, look[2] - cam_h
+                yaw = math.atan2(dy, dx)
+                pitch = -math.atan2(dz, math.hypot(dx, dy))
+                poses.append(look_at_pose(eye, yaw, pitch))
+    poses = poses[::cfg.stride]
+    if cfg.max_frames is not None and len(poses) > cfg.max_frames:
+        keep = np.round(np.linspace(0, len(poses) - 1, cfg.max_frames)).astype(int)
+        poses = [poses[i] for i in keep]
+    return poses
+
+
+def explore(sim: Simulator, cfg: ExploreConfig | None = None) -> Iterator[Frame]:
+    """Render the exploration pass lazily; frame indices count from 0."""
+    for i, T in enumerate(plan_exploration(sim, cfg if cfg is not None else ExploreConfig())):
+        yield sim.render(T, index=i)
+
+
+def _room_order(sim: Simulator) -> list[int]:
+    """Rooms in breadth-first order over the doors, starting from the living room."""
+    plan = sim.apartment.plan
+    start = plan.types.index("living room") if "living room" in plan.types else 0
+    seen, queue = [start], [start]
+    while queue:
+        k = queue.pop(0)
+        for d in plan.doors:
+            if k in d.rooms:
+                other = d.rooms[1] if d.rooms[0] == k else d.rooms[0]
+                if other not in seen:
+                    seen.append(other)
+                    queue.append(other)
+    return seen + [k for k in range(len(plan.rooms)) if k not in seen]
+
+
+def _spread_points(pts: NDArray[np.float64], grid: object, n: int,
+                   rng: np.random.Generator) -> list[NDArray[np.float64]]:
+    """The most open point of the room, then farthest-point samples."""
+    from capnav.sim.navgrid import NavGrid
+
+    assert isinstance(grid, NavGrid)
+    rc = grid.spec.to_cell(pts)
+    clear = grid.clearance[rc[:, 0], rc[:, 1]]
+    chosen = [pts[int(np.argmax(clear))]]
+    while len(chosen) < n:
+        d = np.min([np.hypot(pts[:, 0] - c[0], pts[:, 1] - c[1]) for c in chosen], axis=0)
+        chosen.append(pts[int(np.argmax(d + 0.01 * rng.random(len(d))))])
+    return chosen
+
+
+def _walk(sim: Simulator, a: NDArray[np.float64], b: NDArray[np.float64],
+          cfg: ExploreConfig) -> list[NDArray[np.float64]]:
+    path = sim.shortest_path((float(a[0]), float(a[1])), (float(b[0]), float(b[1])))
+    if len(path) < 2:
+        return []
+    seg = np.hypot(*np.diff(path, axis=0).T)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    out = []
+    cam_h = sim.config.agent.camera_height
+    for t in np.arange(cfg.travel_step, s[-1] - 1e-6, cfg.travel_step):
+        i = int(np.searchsorted(s, t) - 1)
+        i = min(max(i, 0), len(seg) - 1)
+        f = (t - s[i]) / max(seg[i], 1e-9)
+        p = path[i] + f * (path[i + 1] - path[i])
+        ahead = path[min(len(path) - 1, i + 6)] - p  # look a little ahead, not at the next cell
+        yaw = math.atan2(ahead[1], ahead[0]) if np.hypot(*ahead) > 1e-6 else 0.0
+        out.append(look_at_pose(np.array([p[0], p[1], cam_h]), yaw, math.radians(cfg.travel_pitch_deg)))
+    return out
