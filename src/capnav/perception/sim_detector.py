@@ -6,7 +6,7 @@ a frame's detections do not depend on the order frames are processed in:
 
 * quality ``q = size * occlusion * distance`` where ``size = 1 / (1 + (a50 / a)^2)`` for the mask
   area fraction ``a``; ``occlusion = 1 - w_occ * o`` with ``o`` the fraction of the mask outline
-  that borders a nearer surface or the image border (occluders and truncation); ``distance =
+  that borders a nearer surface (occluders; pixels on the image border count half: truncation); ``distance =
   exp(-max(0, d - d_free) / d_scale)`` for the mean depth ``d``;
 * a miss with probability ``1 - p_max * q`` (misses grow with occlusion, small size, distance);
 * a label swap inside ``core.categories.CONFUSION_GROUPS`` with probability
@@ -74,13 +74,12 @@ def resolve_noise(noise: str | SimNoise) -> tuple[str, SimNoise]:
 
 def occluded_outline(inst: NDArray[np.integer], depth: NDArray[np.floating], gap: float
                      ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
-    """Per pixel: (on an instance outline, outline pixel next to a nearer surface or the border)."""
+    """Per pixel: (on an instance outline or the image border, outline pixel next to a nearer surface)."""
     h, w = inst.shape
     d = np.where(np.isfinite(depth) & (depth > 0), depth, np.inf).astype(np.float32)
     outline = np.zeros((h, w), dtype=bool)
     occl = np.zeros((h, w), dtype=bool)
     outline[0, :] = outline[-1, :] = outline[:, 0] = outline[:, -1] = True
-    occl[0, :] = occl[-1, :] = occl[:, 0] = occl[:, -1] = True
     for sl_a, sl_b in (((slice(1, None), slice(None)), (slice(None, -1), slice(None))),
                        ((slice(None), slice(1, None)), (slice(None), slice(None, -1)))):
         diff = inst[sl_a] != inst[sl_b]
@@ -129,7 +128,9 @@ class SimDetector(Detector):
         dcnt = np.bincount(ids.ravel(), weights=valid.ravel().astype(np.float64), minlength=nbin)
         outline, occl = occluded_outline(ids, depth, cfg.occluder_gap)
         n_out = np.bincount(ids.ravel(), weights=outline.ravel().astype(np.float64), minlength=nbin)
-        n_occ = np.bincount(ids.ravel(), weights=occl.ravel().astype(np.float64), minlength=nbin)
+        border = np.zeros((h, w), dtype=np.float64)
+        border[0, :] = border[-1, :] = border[:, 0] = border[:, -1] = 0.5  # truncation: half an occlusion
+        n_occ = np.bincount(ids.ravel(), weights=np.maximum(occl, border).ravel(), minlength=nbin)
         slices = ndimage.find_objects(ids)
         dets: list[Detection] = []
         for iid in range(1, nbin):
