@@ -1,8 +1,8 @@
 """Language stage: view selection, captioners, text embedders and their caches (paper 3.3)."""
 
+import capnav.language.remote_captioners  # noqa: F401
 from capnav.language import offline_captioner as _offline  # noqa: F401  (registers backends)
 from capnav.language import onnx_embedder as _onnx_embedder  # noqa: F401
-from capnav.language import remote_captioners as _remote  # noqa: F401
 from capnav.language import st_embedder as _st_embedder  # noqa: F401
 from capnav.language.captioner import CAPTIONERS, Caption, Captioner, RetryPolicy, create_captioner
 from capnav.language.context import SceneContext

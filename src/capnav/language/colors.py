@@ -58,7 +58,7 @@ ALIASES: dict[str, str] = {
     "gray": "grey", "light gray": "light grey", "dark gray": "dark grey", "navy blue": "navy",
     "off-white": "cream", "off white": "cream", "ivory": "cream", "charcoal": "dark grey",
     "violet": "purple", "maroon": "red", "crimson": "red", "golden": "mustard", "gold": "mustard",
-    "wooden": "oak", "chrome": "silver", "steel": "silver", "turquoise": "teal", "khaki": "tan",
+    "chrome": "silver", "steel": "silver", "turquoise": "teal", "khaki": "tan",
 }
 
 
