@@ -46,7 +46,10 @@ def occupancy_from_voxels(voxels: VoxelMap, config: OccupancyConfig | None = Non
         if len(c) == 0:
             spec = GridSpec(0.0, 0.0, cfg.resolution, 1, 1)
         else:
-            lo, hi = c[:, :2].min(axis=0), c[:, :2].max(axis=0)
+            # Grid lines on voxel faces (centre - s/2), never through voxel centres: a centre exactly
+            # on a cell boundary falls either way under round-off and leaves stripes of UNKNOWN cells.
+            h = voxels.resolution / 2.0
+            lo, hi = c[:, :2].min(axis=0) - h, c[:, :2].max(axis=0) + h
             spec = GridSpec.covering(float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]), cfg.resolution,
                                      cfg.margin)
     cells = np.full((spec.rows, spec.cols), UNKNOWN, dtype=np.uint8)
