@@ -1,0 +1,1 @@
+"""The main job: explore -> map -> describe -> ask -> navigate -> report, on one apartment."""

@@ -1,0 +1,108 @@
+"""Write the demo's report as Markdown and as a self-contained-folder HTML page.
+
+Pictures are files beside the report (``images/``) so both formats show them; the HTML escapes
+every piece of text that came from a model or a user.
+"""
+
+from __future__ import annotations
+
+import html
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from capnav.core.atomic import write_text
+
+
+@dataclass
+class ReportItem:
+    """One instruction and what CapNav did with it."""
+
+    instruction: str
+    kind: str  # instruction kind (attribute, superlative, relation, closest, category, absent, user)
+    found: bool
+    chosen_id: int | None
+    chosen_label: str | None
+    caption: str | None
+    score: float | None
+    reason: str
+    runners_up: list[str] = field(default_factory=list)
+    reached: bool | None = None  # the agent stopped within the reach radius of the chosen object
+    correct: bool | None = None  # judged against the simulator's truth (None for user instructions)
+    path_length: float | None = None
+    nav_reason: str = ""
+    view_png: str | None = None  # path relative to the report folder
+    map_png: str | None = None
+    timings: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass
+class Report:
+    title: str
+    summary: list[tuple[str, str]]  # (label, value) rows
+    items: list[ReportItem]
+    overview_png: str | None = None
+
+
+def _verdict(it: ReportItem) -> str:
+    if not it.found:
+        return "not found" + (" (correct)" if it.correct else " (wrong)" if it.correct is False else "")
+    parts = ["reached" if it.reached else "not reached"]
+    if it.correct is not None:
+        parts.append("right object" if it.correct else "wrong object")
+    return ", ".join(parts)
+
+
+def write_markdown(report: Report, path: Path) -> None:
+    lines = [f"# {report.title}", ""]
+    lines += ["| | |", "|---|---|"] + [f"| {k} | {v} |" for k, v in report.summary] + [""]
+    if report.overview_png:
+        lines += [f"![apartment]({report.overview_png})", ""]
+    for i, it in enumerate(report.items, 1):
+        lines += [f"## {i}. \"{it.instruction}\"", "", f"*{it.kind}* — **{_verdict(it)}**", ""]
+        if it.found:
+            lines += [f"- chosen: object {it.chosen_id} ({it.chosen_label}), score {it.score:.3f}",
+                      f"- caption: {it.caption}"]
+        lines += [f"- reason: {it.reason}"]
+        if it.runners_up:
+            lines += ["- runners-up: " + "; ".join(it.runners_up)]
+        if it.nav_reason:
+            lines += [f"- navigation: {it.nav_reason}" + (f" ({it.path_length:.1f} m)" if it.path_length else "")]
+        lines.append("")
+        pics = [p for p in (it.view_png, it.map_png) if p]
+        if pics:
+            lines += [" ".join(f"![]({p})" for p in pics), ""]
+    write_text(path, "\n".join(lines))
+
+
+def write_html(report: Report, path: Path) -> None:
+    e = html.escape
+    rows = "".join(f"<tr><th>{e(k)}</th><td>{e(v)}</td></tr>" for k, v in report.summary)
+    parts = [
+        "<!doctype html><html><head><meta charset='utf-8'>",
+        f"<title>{e(report.title)}</title>",
+        "<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
+        "table{border-collapse:collapse}th,td{border:1px solid #ccc;padding:4px 8px;text-align:left}"
+        ".item{border-top:2px solid #ddd;margin-top:1.5em;padding-top:.5em}.ok{color:#1a7f37}.bad{color:#b42318}"
+        ".pics img{max-height:360px;margin-right:8px;border:1px solid #ccc}</style></head><body>",
+        f"<h1>{e(report.title)}</h1><table>{rows}</table>",
+    ]
+    if report.overview_png:
+        parts.append(f"<p><img src='{e(report.overview_png)}' style='max-width:600px'></p>")
+    for i, it in enumerate(report.items, 1):
+        good = (it.correct is not False) and (it.reached is not False)
+        parts.append(f"<div class='item'><h2>{i}. &ldquo;{e(it.instruction)}&rdquo;</h2>")
+        parts.append(f"<p><i>{e(it.kind)}</i> &mdash; <b class='{'ok' if good else 'bad'}'>{e(_verdict(it))}</b></p><ul>")
+        if it.found:
+            parts.append(f"<li>chosen: object {it.chosen_id} ({e(str(it.chosen_label))}), score {it.score:.3f}</li>")
+            parts.append(f"<li>caption: <q>{e(str(it.caption))}</q></li>")
+        parts.append(f"<li>reason: {e(it.reason)}</li>")
+        if it.runners_up:
+            parts.append("<li>runners-up: " + e("; ".join(it.runners_up)) + "</li>")
+        if it.nav_reason:
+            extra = f" ({it.path_length:.1f} m)" if it.path_length else ""
+            parts.append(f"<li>navigation: {e(it.nav_reason)}{extra}</li>")
+        parts.append("</ul><div class='pics'>")
+        parts += [f"<img src='{e(p)}'>" for p in (it.view_png, it.map_png) if p]
+        parts.append("</div></div>")
+    parts.append("</body></html>")
+    write_text(path, "\n".join(parts))

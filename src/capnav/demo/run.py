@@ -1,0 +1,183 @@
+"""The main job on one generated apartment: explore, map, caption, embed, ask, navigate, report.
+
+The pipeline (mapping, captioning, retrieval, planning) sees observations only; the simulator's
+truth is used here for two things a user would want from a demo: choosing instructions that
+single out one object among lookalikes, and saying afterwards whether the agent reached the
+object the instruction meant.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from rich.console import Console
+
+from capnav.core.atomic import write_bytes, write_json
+from capnav.core.errors import CapNavError, InputError
+from capnav.demo.report import Report, ReportItem, write_html, write_markdown
+from capnav.eval.pipeline import PipelineConfig, open_scene
+from capnav.eval.success import SUCCESS_RADIUS_M, distance_to_instances
+from capnav.mapping.objects import MapObject
+from capnav.planning import PlannerConfig, navigate_to
+from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
+
+#: One instruction of each kind by default: what CapNav is for first, then the classic cases.
+DEFAULT_KINDS = ("attribute", "superlative", "relation", "closest", "room", "category", "absent")
+
+
+@dataclass
+class DemoConfig:
+    seed: int = 0
+    out: Path = Path("runs/demo")
+    width: int = 320
+    height: int = 240
+    max_frames: int | None = None
+    kinds: tuple[str, ...] = DEFAULT_KINDS
+    instructions: tuple[str, ...] = ()  # the user's own; replaces the generated ones when given
+    verifier: str = "offline"
+    captioner: str = "offline"
+
+    def __post_init__(self) -> None:
+        if self.seed < 0:
+            raise InputError(f"seed must be >= 0, got {self.seed}")
+        if not (32 <= self.width <= 1920 and 24 <= self.height <= 1440):
+            raise InputError(f"image size {self.width}x{self.height} is outside 32x24 .. 1920x1440")
+
+
+@dataclass
+class DemoResult:
+    report_html: Path
+    report_md: Path
+    items: list[ReportItem]
+    timings: dict[str, float] = field(default_factory=dict)
+
+
+def _png(obj: MapObject) -> bytes | None:
+    for v in obj.views:
+        if v.frame_png:
+            return v.frame_png
+    return None
+
+
+def _instructions(cfg: DemoConfig, sim: Any, start_xy: tuple[float, float]) -> list[tuple[str, str, list[int]]]:
+    """(text, kind, target instance ids) for the demo: the user's, or one generated per kind."""
+    if cfg.instructions:
+        return [(t, "user", []) for t in cfg.instructions]
+    from capnav.eval.instructions import generate_instructions
+
+    rng = np.random.default_rng(cfg.seed)
+    out: list[tuple[str, str, list[int]]] = []
+    for kind in cfg.kinds:
+        cands = generate_instructions(sim.manifest, seed=int(rng.integers(1 << 31)), kinds=(kind,),
+                                      robot_xy=start_xy, per_kind=1)
+        out.extend((c.text, c.kind, list(c.target_ids)) for c in cands[:1])
+    return out
+
+
+def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
+    con = console or Console(stderr=True)
+    out = cfg.out
+    (out / "images").mkdir(parents=True, exist_ok=True)
+    timings: dict[str, float] = {}
+
+    t0 = time.perf_counter()
+    pcfg = PipelineConfig(width=cfg.width, height=cfg.height, max_frames=cfg.max_frames,
+                          captioner=cfg.captioner, verifier=cfg.verifier)
+    con.print(f"[bold]1/4[/] apartment seed {cfg.seed}: building the simulator")
+    assets = open_scene(cfg.seed, cfg.seed, pcfg, out)
+    sim = assets.sim
+    con.print(f"     {len(sim.manifest.rooms)} rooms, {len(sim.manifest.objects)} objects "
+              f"({time.perf_counter() - t0:.1f} s)")
+    from capnav.viz.scene import draw_scene
+
+    draw_scene(sim.manifest, out / "images" / "apartment.png", navigable=sim.navigable())
+
+    t1 = time.perf_counter()
+    con.print("[bold]2/4[/] exploring, mapping (SG3DTracker + voxel map), captioning and embedding")
+    cmap = assets.prior_map()
+    timings.update(assets.timings)
+    con.print(f"     {len(assets.stream())} frames -> {len(cmap.objects)} objects in the map "
+              f"({time.perf_counter() - t1:.1f} s); map saved to {out / 'map.capnav'}")
+
+    retriever = Retriever(cmap, assets.embedder, create_verifier(cfg.verifier), RetrievalConfig())
+    rng = np.random.default_rng(cfg.seed + 1)
+    start = assets.truth.sample_start(rng)
+    agent = sim.spawn_agent(start.x, start.y, start.yaw)
+    instructions = _instructions(cfg, sim, (start.x, start.y))
+
+    con.print(f"[bold]3/4[/] answering {len(instructions)} instructions and navigating")
+    items: list[ReportItem] = []
+    pcfg_plan = PlannerConfig()
+    for k, (text, kind, targets) in enumerate(instructions, 1):
+        items.append(_answer(k, text, kind, targets, retriever, agent, cmap, assets, pcfg_plan, out))
+        it = items[-1]
+        con.print(f"     {k}. {text!r}: {it.chosen_label or 'not found'} -> "
+                  f"{'reached' if it.reached else 'not reached' if it.found else '-'}"
+                  + ("" if it.correct is None else f", {'right' if it.correct else 'wrong'}"))
+
+    con.print("[bold]4/4[/] writing the report")
+    timings["total"] = time.perf_counter() - t0
+    judged = [it for it in items if it.correct is not None]
+    summary = [
+        ("apartment seed", str(cfg.seed)),
+        ("rooms / objects (truth)", f"{len(sim.manifest.rooms)} / {len(sim.manifest.objects)}"),
+        ("frames explored", str(len(assets.stream()))),
+        ("objects in the map", str(len(cmap.objects))),
+        ("instructions right (truth)", f"{sum(bool(it.correct) for it in judged)} / {len(judged)}"),
+        ("time (s)", ", ".join(f"{k} {v:.1f}" for k, v in timings.items())),
+    ]
+    report = Report(f"CapNav demo: apartment {cfg.seed}", summary, items, overview_png="images/apartment.png")
+    md, html_path = out / "report.md", out / "report.html"
+    write_markdown(report, md)
+    write_html(report, html_path)
+    write_json(out / "report.json", {"summary": dict(summary), "items": [vars(it) for it in items]})
+    con.print(f"     {html_path}")
+    return DemoResult(html_path, md, items, timings)
+
+
+def _answer(k: int, text: str, kind: str, targets: list[int], retriever: Retriever, agent: Any, cmap: Any,
+            assets: Any, plan_cfg: PlannerConfig, out: Path) -> ReportItem:
+    from capnav.viz.topdown import write_navigation
+
+    start_pose = tuple(float(v) for v in agent.pose)
+    try:
+        res = retriever.query(text, robot_xy=(start_pose[0], start_pose[1]))
+    except CapNavError as e:  # e.g. an empty or non-English instruction: report it, keep going
+        return ReportItem(text, kind, False, None, None, None, None, f"rejected: {e}",
+                          correct=None if kind == "user" else False)
+    item = ReportItem(text, kind, res.found, res.chosen.id if res.chosen else None,
+                      res.chosen.label if res.chosen else None, res.chosen.caption if res.chosen else None,
+                      res.score if res.found else None, res.reason,
+                      runners_up=[f"{o.id} {o.label} ({s:.2f})" for o, s in res.ranked[:3]],
+                      timings=dict(res.timings))
+    if kind == "absent":
+        item.correct = not res.found
+    elif targets:
+        item.correct = False  # until the agent is seen to stop within reach of a target
+    if res.chosen is None:
+        return item
+    obj = res.chosen
+    view = _png(obj)
+    if view:
+        item.view_png = f"images/{k:02d}_view.png"
+        write_bytes(out / item.view_png, view)
+    try:
+        nav = navigate_to(agent, cmap.occupancy, obj.footprint, plan_cfg)
+    except CapNavError as e:
+        item.reached, item.nav_reason = False, f"could not plan: {e}"
+        return item
+    item.reached, item.nav_reason, item.path_length = nav.reached, nav.reason, nav.path_length
+    if targets:
+        fps = [assets.truth.footprints[t] for t in targets]
+        item.correct = distance_to_instances(nav.final_pose[:2], fps) <= SUCCESS_RADIUS_M
+    png, _ = write_navigation(out / "images", f"{k:02d}_nav", cmap.occupancy, cmap.objects, obj.id,
+                              nav.waypoints, nav.trajectory, start_pose, nav.final_pose, text,
+                              goal=None if nav.goal is None else (*nav.goal.xy, nav.goal.yaw), reach=plan_cfg.reach)
+    item.map_png = f"images/{png.name}"
+    return item
+
+
