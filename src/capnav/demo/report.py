@@ -91,7 +91,8 @@ def write_html(report: Report, path: Path) -> None:
     for i, it in enumerate(report.items, 1):
         good = (it.correct is not False) and (it.reached is not False)
         parts.append(f"<div class='item'><h2>{i}. &ldquo;{e(it.instruction)}&rdquo;</h2>")
-        parts.append(f"<p><i>{e(it.kind)}</i> &mdash; <b class='{'ok' if good else 'bad'}'>{e(_verdict(it))}</b></p><ul>")
+        css = "ok" if good else "bad"
+        parts.append(f"<p><i>{e(it.kind)}</i> &mdash; <b class='{css}'>{e(_verdict(it))}</b></p><ul>")
         if it.found:
             parts.append(f"<li>chosen: object {it.chosen_id} ({e(str(it.chosen_label))}), score {it.score:.3f}</li>")
             parts.append(f"<li>caption: <q>{e(str(it.caption))}</q></li>")
