@@ -2,11 +2,19 @@
 objects, occupancy and the ``CapNavMap`` they form."""
 
 from capnav.mapping.cmap import CapNavMap
-from capnav.mapping.lifting import LiftConfig, LiftedDetection, lift_detection, mask_descriptor
+from capnav.mapping.lifting import (
+    LiftConfig,
+    LiftedDetection,
+    indexed_descriptor,
+    lift_detection,
+    mask_descriptor,
+    outline_visibility,
+)
 from capnav.mapping.mapper import Mapper, MapperConfig, build_map
 from capnav.mapping.memory import MemoryConfig, ObjectMemory
 from capnav.mapping.objects import MapObject, ObjectView, Observation
 from capnav.mapping.occupancy import OccupancyConfig, occupancy_from_voxels
+from capnav.mapping.stream import map_dataset
 from capnav.mapping.tracker import SG3DTracker, Track, TrackerConfig, TrackerStep
 from capnav.mapping.voxel_map import VoxelConfig, VoxelMap, radial_weight, random_projection
 
@@ -29,9 +37,12 @@ __all__ = [
     "VoxelConfig",
     "VoxelMap",
     "build_map",
+    "indexed_descriptor",
     "lift_detection",
+    "map_dataset",
     "mask_descriptor",
     "occupancy_from_voxels",
+    "outline_visibility",
     "radial_weight",
     "random_projection",
 ]

@@ -97,3 +97,58 @@ def fuse(table_keys: NDArray[np.int64], table_vals: NDArray[np.int32], shift: np
             features[s, j] += r * (phi[fi, j] - features[s, j])
         weights[s] = w_new
     return n
+
+
+@nb.njit(cache=True, nogil=True)
+def fuse_image(table_keys: NDArray[np.int64], table_vals: NDArray[np.int32], shift: np.uint64,
+               voxel_keys: NDArray[np.int64], weights: NDArray[np.float64], colors: NDArray[np.float32],
+               features: NDArray[np.float32], n: int, depth: NDArray[np.float32], rgb: NDArray[np.uint8],
+               intr: NDArray[np.float64], T: NDArray[np.float64], origin: NDArray[np.float64], res: float,
+               sigma: float, max_depth: float, stride: int, cell_rows: int, cell_cols: int,
+               feat_grid: NDArray[np.int64], phi: NDArray[np.float32]) -> int:
+    """Eq. 2-8 for every ``stride``-th valid pixel of one frame, in row-major order, without
+    temporaries: back-project (eq. 2-3), weight (eq. 5), index (eq. 4), fuse (eq. 6-8).
+    Pixel (u, v) takes feature row ``feat_grid[v * cell_rows // H, u * cell_cols // W]``."""
+    h, w = depth.shape
+    fx, fy, cx, cy = intr[0], intr[1], intr[2], intr[3]
+    inv2s2 = 1.0 / (2.0 * sigma * sigma)
+    d = features.shape[1]
+    off = np.int64(1 << 20)
+    for v in range(0, h, stride):
+        for u in range(0, w, stride):
+            z = np.float64(depth[v, u])
+            if not (z > 0.0 and z <= max_depth):  # also rejects NaN
+                continue
+            x = (u - cx) * z / fx
+            y = (v - cy) * z / fy
+            a = np.exp(-(x * x + y * y + z * z) * inv2s2)
+            wx = T[0, 0] * x + T[0, 1] * y + T[0, 2] * z + T[0, 3]
+            wy = T[1, 0] * x + T[1, 1] * y + T[1, 2] * z + T[1, 3]
+            wz = T[2, 0] * x + T[2, 1] * y + T[2, 2] * z + T[2, 3]
+            i = np.int64(np.floor((wx - origin[0]) / res)) + off
+            j = np.int64(np.floor((wy - origin[1]) / res)) + off
+            k = np.int64(np.floor((wz - origin[2]) / res)) + off
+            key = (i << 42) | (j << 21) | k
+            hh = _slot_of(table_keys, key, shift)
+            if table_keys[hh] == -1:
+                table_keys[hh] = key
+                table_vals[hh] = n
+                s = n
+                voxel_keys[s] = key
+                weights[s] = 0.0
+                for c in range(3):
+                    colors[s, c] = 0.0
+                for jj in range(d):
+                    features[s, jj] = 0.0
+                n += 1
+            else:
+                s = table_vals[hh]
+            w_new = weights[s] + a
+            r = np.float32(a / w_new)
+            for c in range(3):
+                colors[s, c] += r * (np.float32(rgb[v, u, c]) - colors[s, c])
+            fi = feat_grid[v * cell_rows // h, u * cell_cols // w]
+            for jj in range(d):
+                features[s, jj] += r * (phi[fi, jj] - features[s, jj])
+            weights[s] = w_new
+    return n

@@ -65,45 +65,67 @@ def mask_descriptor(mask: NDArray[np.bool_], phi: NDArray[np.float32]) -> NDArra
     return ((counts[nz].astype(np.float32) @ flat[nz]) / np.float32(vs.size)).astype(np.float32)
 
 
-def outline_visibility(mask: NDArray[np.bool_], depth: NDArray[np.floating], gap: float = 0.05) -> float:
-    """Share of the mask outline that is not next to a nearer surface or the image border."""
-    rows = np.flatnonzero(mask.any(axis=1))
-    cols = np.flatnonzero(mask.any(axis=0))
-    if rows.size == 0:
+def outline_visibility(mask: NDArray[np.bool_], depth: NDArray[np.floating], gap: float = 0.05,
+                       image_border: tuple[bool, bool, bool, bool] | None = None) -> float:
+    """Share of the mask outline not next to a nearer surface (an occluder) nor on the image border.
+
+    ``mask`` / ``depth`` may be a crop; ``image_border`` says which crop sides (top, left, bottom,
+    right) are the image border (default: all four, i.e. the arrays are the whole image)."""
+    if not mask.any():
         return 0.0
-    h, w = mask.shape
-    y0, y1 = max(rows[0] - 1, 0), min(rows[-1] + 2, h)
-    x0, x1 = max(cols[0] - 1, 0), min(cols[-1] + 2, w)
-    m = mask[y0:y1, x0:x1]
-    d = np.where(np.isfinite(depth[y0:y1, x0:x1]) & (depth[y0:y1, x0:x1] > 0), depth[y0:y1, x0:x1], np.inf)
-    dm = np.where(m, d, np.nan)
-    # Median depth of the object: a neighbour nearer than that by ``gap`` is an occluder.
-    ref = float(np.nanmedian(dm[np.isfinite(dm)])) if np.isfinite(dm).any() else np.inf
-    edge = m & ~ndimage.binary_erosion(m, border_value=1)
-    ring = ndimage.binary_dilation(m) & ~m
-    occluder = ring & (d < ref - gap)
-    near_occ = ndimage.binary_dilation(occluder) & edge
-    n_edge = int(edge.sum())
-    border = np.zeros_like(m)
-    if y0 == 0:
+    top, left, bottom, right = image_border if image_border is not None else (True, True, True, True)
+    d = np.where(np.isfinite(depth) & (depth > 0), depth, np.inf)
+    zm = d[mask]
+    zm = zm[np.isfinite(zm)]
+    ref = float(np.median(zm)) if zm.size else np.inf
+    edge = mask & ~ndimage.binary_erosion(mask, border_value=1)
+    ring = ndimage.binary_dilation(mask) & ~mask
+    near_occ = ndimage.binary_dilation(ring & (d < ref - gap)) & edge
+    border = np.zeros_like(mask)
+    if top:
         border[0] = True
-    if x0 == 0:
+    if left:
         border[:, 0] = True
-    if y1 == h:
+    if bottom:
         border[-1] = True
-    if x1 == w:
+    if right:
         border[:, -1] = True
-    bad = near_occ | (m & border)
-    n_total = n_edge + int((m & border).sum())
-    return 1.0 - float(bad.sum()) / max(n_total, 1)
+    on_border = mask & border
+    n_total = int(edge.sum()) + int(on_border.sum())
+    return 1.0 - float((near_occ | on_border).sum()) / max(n_total, 1)
 
 
-def lift_detection(frame: Frame, det: Detection, index: int, phi: NDArray[np.float32],
-                   cfg: LiftConfig = LiftConfig()) -> LiftedDetection | None:
-    """Lift one detection; ``None`` when its mask has no valid depth (the caller logs the skip)."""
-    depth = frame.depth
+def indexed_descriptor(mask: NDArray[np.bool_], grid: NDArray[np.integer], table: NDArray[np.float32],
+                       offset: tuple[int, int] = (0, 0), image_shape: tuple[int, int] | None = None
+                       ) -> NDArray[np.float32]:
+    """Eq. 10 for a factored feature map ``Phi = table[grid]``; ``mask`` may be a crop of the image
+    whose top-left pixel is ``offset`` (row, col) in an image of ``image_shape``."""
+    h, w = image_shape if image_shape is not None else mask.shape
+    hh, ww = grid.shape
+    vs, us = np.nonzero(mask)
+    if vs.size == 0:
+        return np.zeros(table.shape[1], dtype=np.float32)
+    rows = grid[(vs + offset[0]) * hh // h, (us + offset[1]) * ww // w]
+    counts = np.bincount(rows, minlength=len(table))
+    nz = np.flatnonzero(counts)
+    return ((counts[nz].astype(np.float32) @ table[nz]) / np.float32(vs.size)).astype(np.float32)
+
+
+def lift_detection(frame: Frame, det: Detection, index: int, grid: NDArray[np.integer],
+                   table: NDArray[np.float32], cfg: LiftConfig = LiftConfig()) -> LiftedDetection | None:
+    """Lift one detection (features as ``table[grid]``, see ``DenseFeatureEncoder.encode_indexed``);
+    ``None`` when its mask has no valid depth (the caller logs the skip). Works on the box crop."""
+    h, w = frame.shape
+    x0, y0, x1, y1 = det.box
+    c0, r0 = max(int(np.floor(x0)) - 2, 0), max(int(np.floor(y0)) - 2, 0)
+    c1, r1 = min(int(np.ceil(x1)) + 2, w), min(int(np.ceil(y1)) + 2, h)
+    mask = det.mask[r0:r1, c0:c1]
+    if mask.sum() != det.area:  # the box does not cover the mask: fall back to the whole image
+        r0, c0, r1, c1 = 0, 0, h, w
+        mask = det.mask
+    depth = np.asarray(frame.depth)[r0:r1, c0:c1]
     K = frame.K
-    vs, us = np.nonzero(det.mask)
+    vs, us = np.nonzero(mask)
     if vs.size == 0:
         return None
     z_all = depth[vs, us]
@@ -116,11 +138,11 @@ def lift_detection(frame: Frame, det: Detection, index: int, phi: NDArray[np.flo
     if near.sum() < 3:
         near = ok
     z = float(np.median(z_all[near]))
-    pc = np.array([(uc - K.cx) * z / K.fx, (vc - K.cy) * z / K.fy, z])
+    pc = np.array([(uc + c0 - K.cx) * z / K.fx, (vc + r0 - K.cy) * z / K.fy, z])
     T = np.asarray(frame.T_wc, dtype=np.float64)
     pos = T[:3, :3] @ pc + T[:3, 3]
 
-    core = ndimage.binary_erosion(det.mask, iterations=cfg.erode) if cfg.erode > 0 else det.mask
+    core = ndimage.binary_erosion(mask, iterations=cfg.erode) if cfg.erode > 0 else mask
     pv, pu = np.nonzero(core)
     if pv.size < 8:
         pv, pu = vs, us
@@ -135,12 +157,14 @@ def lift_detection(frame: Frame, det: Detection, index: int, phi: NDArray[np.flo
     if pz.size > cfg.max_points:
         sel = np.linspace(0, pz.size - 1, cfg.max_points).astype(np.intp)
         pv, pu, pz = pv[sel], pu[sel], pz[sel]
+    pv, pu = pv + r0, pu + c0
     cam = np.stack([(pu - K.cx) * pz / K.fx, (pv - K.cy) * pz / K.fy, pz], axis=1)
     pts = (cam @ T[:3, :3].T + T[:3, 3]).astype(np.float32)
     cols = np.asarray(frame.rgb)[pv, pu].astype(np.uint8)
-    h, w = frame.shape
     return LiftedDetection(
-        index=index, detection=det, position=pos, descriptor=mask_descriptor(det.mask, phi),
+        index=index, detection=det, position=pos,
+        descriptor=indexed_descriptor(mask, grid, table, (r0, c0), (h, w)),
         points=pts, colors=cols, distance=float(np.linalg.norm(pc)),
-        visibility=outline_visibility(det.mask, depth), truncated=det.truncated(w, h),
+        visibility=outline_visibility(mask, depth, image_border=(r0 == 0, c0 == 0, r1 == h, c1 == w)),
+        truncated=det.truncated(w, h),
     )

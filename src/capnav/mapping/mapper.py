@@ -10,11 +10,9 @@ from dataclasses import asdict, dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-from numpy.typing import NDArray
 
 from capnav.core.errors import FrameError, InputError
 from capnav.core.frame import Frame
-from capnav.core.geometry import backproject
 from capnav.core.progress import track
 from capnav.mapping.cmap import CapNavMap
 from capnav.mapping.lifting import LiftConfig, LiftedDetection, lift_detection
@@ -22,7 +20,7 @@ from capnav.mapping.memory import MemoryConfig, ObjectMemory
 from capnav.mapping.objects import Observation
 from capnav.mapping.occupancy import OccupancyConfig, occupancy_from_voxels
 from capnav.mapping.tracker import SG3DTracker, TrackerConfig
-from capnav.mapping.voxel_map import VoxelConfig, VoxelMap, radial_weight, random_projection
+from capnav.mapping.voxel_map import VoxelConfig, VoxelMap, random_projection
 from capnav.perception.base import DenseFeatureEncoder, Detector, validate_detections
 
 log = logging.getLogger(__name__)
@@ -75,14 +73,17 @@ class Mapper:
         self.skipped: list[dict[str, Any]] = []
         self.lift_skips = 0
         self.seconds = 0.0
-        self._stride_masks: dict[tuple[int, int], NDArray[np.bool_]] = {}
 
     def _bad(self, err: FrameError) -> bool:
         if self.config.on_bad_frame == "raise":
             raise err
-        log.warning("skipping %s", err)
-        self.skipped.append({"frame": err.frame, "reason": err.reason})
+        self.record_skip(err.frame, err.reason)
         return False
+
+    def record_skip(self, frame: int | str, reason: str) -> None:
+        """Note a frame that could not be used (also for frames a reader failed to load)."""
+        log.warning("skipping frame %s: %s", frame, reason)
+        self.skipped.append({"frame": frame, "reason": reason})
 
     def integrate(self, frame: Frame) -> bool:
         """Fuse one frame; returns False when it was skipped (see ``MapperConfig.on_bad_frame``)."""
@@ -90,18 +91,25 @@ class Mapper:
         try:
             frame.validate(max_invalid_fraction=self.config.max_invalid_depth)
             dets = validate_detections(frame, self.detector.detect(frame))
-            phi = np.asarray(self.encoder.encode(frame, dets), dtype=np.float32)
-            if phi.ndim != 3 or phi.shape[2] != self.encoder.dim:
-                raise FrameError(frame.index,
-                                 f"encoder returned shape {phi.shape}, expected (H', W', {self.encoder.dim})")
-            if not np.all(np.isfinite(phi)):
+            grid, table = self.encoder.encode_indexed(frame, dets)
+            grid = np.asarray(grid, dtype=np.int64)
+            table = np.asarray(table, dtype=np.float32)
+            if table.ndim != 2 or table.shape[1] != self.encoder.dim or grid.ndim != 2:
+                raise FrameError(frame.index, f"encoder returned grid {grid.shape} / table {table.shape}, "
+                                              f"expected (H', W') / (M, {self.encoder.dim})")
+            if grid.size == 0 or grid.min() < 0 or grid.max() >= len(table):
+                raise FrameError(frame.index, "encoder feature grid indexes outside its table")
+            if not np.all(np.isfinite(table)):
                 raise FrameError(frame.index, "encoder returned non-finite features")
         except FrameError as e:
             return self._bad(e)
-        self._fuse_voxels(frame, phi)
+        vc = self.config.voxel
+        proj = self.voxels.project(table) if self.voxels.projection is not None else table
+        self.voxels.integrate_frame(frame.depth, frame.rgb, frame.K, frame.T_wc, grid, proj, vc.sigma,
+                                    vc.max_depth, vc.pixel_stride)
         lifted: list[LiftedDetection] = []
         for k, d in enumerate(dets):
-            ld = lift_detection(frame, d, k, phi, self.config.lift)
+            ld = lift_detection(frame, d, k, grid, table, self.config.lift)
             if ld is None:
                 self.lift_skips += 1
                 continue
@@ -110,30 +118,6 @@ class Mapper:
         self.frames_used.append(frame.index)
         self.seconds += time.perf_counter() - t0
         return True
-
-    def _fuse_voxels(self, frame: Frame, phi: NDArray[np.float32]) -> None:
-        vc = self.config.voxel
-        h, w = frame.shape
-        mask = None
-        if vc.pixel_stride > 1:
-            mask = self._stride_masks.get((h, w))
-            if mask is None:
-                mask = np.zeros((h, w), dtype=bool)
-                mask[:: vc.pixel_stride, :: vc.pixel_stride] = True
-                self._stride_masks[(h, w)] = mask
-        depth = np.where(np.asarray(frame.depth) <= vc.max_depth, frame.depth, 0.0)
-        pc, flat = backproject(depth, frame.K, None, mask)
-        if len(pc) == 0:
-            return
-        T = np.asarray(frame.T_wc, dtype=np.float32)
-        pw = pc @ T[:3, :3].T + T[:3, 3]
-        hh, ww, d = phi.shape
-        v, u = np.divmod(flat, w)
-        fidx = (v * hh // h) * ww + (u * ww // w)
-        table = self.voxels.project(phi.reshape(hh * ww, d)) if self.voxels.projection is not None else phi.reshape(
-            hh * ww, d)
-        colors = np.asarray(frame.rgb).reshape(-1, 3)[flat]
-        self.voxels.integrate(pw, radial_weight(pc, vc.sigma), colors, fidx, table)
 
     def _track(self, frame: Frame, lifted: list[LiftedDetection]) -> None:
         step = self.tracker.update(lifted)

@@ -178,8 +178,9 @@ class ObjectMemory:
         cfg = self.config
         allp = np.concatenate([obj.points, pts.astype(np.float32)])
         allc = np.concatenate([obj.colors, cols.astype(np.uint8)])
-        keys = np.floor(allp / cfg.point_voxel).astype(np.int64)
-        _, first = np.unique(keys, axis=0, return_index=True)
+        ijk = np.floor(allp / cfg.point_voxel).astype(np.int64) + (1 << 20)
+        keys = (ijk[:, 0] << 42) | (ijk[:, 1] << 21) | ijk[:, 2]
+        _, first = np.unique(keys, return_index=True)
         first.sort()
         if len(first) > cfg.max_points:
             first = np.sort(self._rng.choice(first, cfg.max_points, replace=False))

@@ -16,11 +16,13 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from capnav.core.errors import CapNavError
 from capnav.core.frame import Frame
 from capnav.core.grid import OCCUPIED, UNKNOWN, OccupancyGrid
 from capnav.mapping.cmap import CapNavMap
@@ -148,3 +150,38 @@ def evaluate_map(cmap: CapNavMap, manifest: SceneManifest, seen: dict[int, int] 
         occupancy_iou=occupancy_iou(cmap.occupancy, truth_occupancy) if truth_occupancy is not None else None,
         per_instance=per, unmatched_objects=unmatched,
     )
+
+
+def truth_for_dataset(dataset: str | Path, manifest: SceneManifest, min_pixels: int = 100
+                      ) -> tuple[dict[int, int] | None, OccupancyGrid | None, str]:
+    """Evaluation truth beside a dataset: per-instance visible-frame counts from its truth images
+    and the simulator's obstacle grid (rebuilt from the manifest's seed, used only if the rebuilt
+    scene is the manifest's scene). Returns (counts or None, grid or None, a note on what is missing)."""
+    notes: list[str] = []
+    seen: dict[int, int] | None = None
+    try:
+        from capnav.io.dataset import DatasetReader
+
+        reader = DatasetReader(dataset)
+        if reader.has_gt:
+            seen = visible_frames((reader.frame(i) for i in range(len(reader))), min_pixels)
+        else:
+            notes.append(f"{dataset} has no truth images: recall counts every instance as seen")
+    except CapNavError as e:
+        notes.append(f"no dataset frames ({e}): recall counts every instance as seen")
+    occ: OccupancyGrid | None = None
+    try:
+        from capnav.sim.simulator import Simulator
+
+        with Simulator.from_seed(manifest.seed) as sim:
+            same = len(sim.manifest.objects) == len(manifest.objects) and all(
+                np.allclose(a.center, b.center, atol=1e-6) for a, b in zip(sim.manifest.objects, manifest.objects,
+                                                                           strict=True))
+            if same:
+                occ = sim.obstacles()
+            else:
+                notes.append("the scene rebuilt from the manifest's seed differs (non-default SimConfig?): "
+                             "occupancy IoU not computed")
+    except CapNavError as e:
+        notes.append(f"occupancy IoU not computed: {e}")
+    return seen, occ, "; ".join(notes)

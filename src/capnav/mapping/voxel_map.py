@@ -21,8 +21,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.core.errors import InputError
+from capnav.core.geometry import Intrinsics
 from capnav.core.grid import GridSpec
-from capnav.mapping import _kernels as K
+from capnav.mapping import _kernels as K_
 
 
 @dataclass(frozen=True)
@@ -93,7 +94,7 @@ class VoxelMap:
 
     def _rehash(self, table_cap: int) -> None:
         self._shift = np.uint64(64 - int(np.log2(table_cap)))
-        self._tk, self._tv = K.rehash(self._keys, self._n, table_cap, self._shift)
+        self._tk, self._tv = K_.rehash(self._keys, self._n, table_cap, self._shift)
 
     def _reserve(self, extra: int) -> None:
         need = self._n + extra
@@ -122,7 +123,7 @@ class VoxelMap:
     @property
     def coords(self) -> NDArray[np.int32]:
         """(N, 3) eq. 4 indices (i, j, k) of the observed voxels."""
-        return K.unpack_keys(self.keys)
+        return K_.unpack_keys(self.keys)
 
     @property
     def colors(self) -> NDArray[np.float32]:
@@ -152,7 +153,7 @@ class VoxelMap:
         """Slot of each voxel index (N, 3) in the arrays above, -1 if never observed."""
         if len(ijk) == 0:
             return np.zeros(0, dtype=np.int64)
-        return K.lookup(self._tk, self._tv, K.pack_keys(ijk), self._shift)
+        return K_.lookup(self._tk, self._tv, K_.pack_keys(ijk), self._shift)
 
     # ---- fusion (eq. 4-8) ----------------------------------------------------------------
     def project(self, vecs: NDArray[np.floating]) -> NDArray[np.float32]:
@@ -178,12 +179,35 @@ class VoxelMap:
         phi = np.ascontiguousarray(phi, dtype=np.float32)
         if phi.ndim != 2 or phi.shape[1] != self.dim:
             raise InputError(f"feature table must be (M, {self.dim}), got {phi.shape}")
-        keys = K.pack_keys(self.index_of(points_w))
+        keys = K_.pack_keys(self.index_of(points_w))
         self._reserve(n)
-        self._n = K.fuse(self._tk, self._tv, self._shift, self._keys, self._w, self._c, self._f, self._n,
+        self._n = K_.fuse(self._tk, self._tv, self._shift, self._keys, self._w, self._c, self._f, self._n,
                          keys, np.ascontiguousarray(alpha, dtype=np.float32),
                          np.ascontiguousarray(colors, dtype=np.uint8),
                          np.ascontiguousarray(feat_index, dtype=np.int64), phi)
+
+    def integrate_frame(self, depth: NDArray[np.floating], rgb: NDArray[np.uint8], K: Intrinsics,
+                        T_wc: NDArray[np.floating], feat_grid: NDArray[np.integer], phi: NDArray[np.float32],
+                        sigma: float, max_depth: float = np.inf, stride: int = 1) -> None:
+        """Fuse a whole frame (eq. 2-8) in one compiled pass: every ``stride``-th pixel with valid
+        depth <= ``max_depth``; pixel (u, v) has feature ``phi[feat_grid[v * H' // H, u * W' // W]]``.
+        Same result as back-projecting and calling ``integrate`` with the points in row-major order."""
+        depth = np.ascontiguousarray(depth, dtype=np.float32)
+        h, w = depth.shape
+        grid = np.ascontiguousarray(feat_grid, dtype=np.int64)
+        phi = np.ascontiguousarray(phi, dtype=np.float32)
+        if phi.ndim != 2 or phi.shape[1] != self.dim:
+            raise InputError(f"feature table must be (M, {self.dim}), got {phi.shape}")
+        if grid.ndim != 2 or grid.size == 0 or grid.min() < 0 or grid.max() >= len(phi):
+            raise InputError(f"feature grid {grid.shape} must index rows of the (M={len(phi)}) feature table")
+        if rgb.shape != (h, w, 3) or (K.height, K.width) != (h, w):
+            raise InputError(f"rgb {rgb.shape} / intrinsics {K.height}x{K.width} do not match depth {depth.shape}")
+        self._reserve(len(range(0, h, stride)) * len(range(0, w, stride)))
+        intr = np.array([K.fx, K.fy, K.cx, K.cy], dtype=np.float64)
+        self._n = K_.fuse_image(self._tk, self._tv, self._shift, self._keys, self._w, self._c, self._f, self._n,
+                                depth, np.ascontiguousarray(rgb, dtype=np.uint8), intr,
+                                np.ascontiguousarray(T_wc, dtype=np.float64), self.origin, self.resolution,
+                                float(sigma), float(max_depth), int(stride), grid.shape[0], grid.shape[1], grid, phi)
 
     # ---- queries -------------------------------------------------------------------------
     def query(self, text_vec: NDArray[np.floating]) -> NDArray[np.float32]:
@@ -220,7 +244,7 @@ class VoxelMap:
         dim = int(np.asarray(features).shape[1]) if np.asarray(features).ndim == 2 else 0
         vm = cls(resolution, tuple(np.asarray(origin, dtype=np.float64).tolist()), dim, projection,  # type: ignore[arg-type]
                  text_space, capacity=max(n, 16))
-        keys = K.pack_keys(np.asarray(coords))
+        keys = K_.pack_keys(np.asarray(coords))
         if n and len(np.unique(keys)) != n:
             raise InputError("voxel coords contain duplicates")
         vm._keys[:n] = keys

@@ -108,6 +108,17 @@ class DenseFeatureEncoder(ABC):
     def encode(self, frame: Frame, detections: Sequence[Detection]) -> NDArray[np.float32]:
         """Feature map (H', W', D) float32."""
 
+    def encode_indexed(self, frame: Frame, detections: Sequence[Detection]
+                       ) -> tuple[NDArray[np.int64], NDArray[np.float32]]:
+        """The same map factored as ``table[grid]``: ``grid`` (H', W') row indices into ``table``
+        (M, D). Encoders whose features repeat (one vector per label) override this so the mapper
+        projects M rows instead of H' x W'; the default factors nothing (M = H' x W')."""
+        phi = np.asarray(self.encode(frame, detections), dtype=np.float32)
+        if phi.ndim != 3:
+            raise FrameError(frame.index, f"encoder {self.id} returned shape {phi.shape}, expected (H', W', D)")
+        hh, ww, d = phi.shape
+        return np.arange(hh * ww, dtype=np.int64).reshape(hh, ww), phi.reshape(hh * ww, d)
+
 
 DETECTORS: Registry[Detector] = Registry("detector")
 ENCODERS: Registry[DenseFeatureEncoder] = Registry("encoder")

@@ -81,6 +81,11 @@ class LabelEmbeddingEncoder(DenseFeatureEncoder):
                 grid[m] = ids[k]
         return grid
 
+    def encode_indexed(self, frame: Frame, detections: Sequence[Detection]
+                       ) -> tuple[NDArray[np.int64], NDArray[np.float32]]:
+        grid = self.label_grid(frame, detections).astype(np.int64)
+        return grid, self._table
+
     def encode(self, frame: Frame, detections: Sequence[Detection]) -> NDArray[np.float32]:
         grid = self.label_grid(frame, detections)  # may grow the table: index it afterwards
         return self._table[grid]
