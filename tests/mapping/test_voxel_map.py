@@ -95,3 +95,36 @@ def test_occupancy_bands() -> None:
     assert occ.cells[0, 2] == FREE
     assert (occ.cells[1] == UNKNOWN).all()
     assert occ.inflated(0.1).cells[0, 12] == OCCUPIED
+
+
+def test_whole_frame_kernel_equals_point_fusion() -> None:
+    from capnav.core.geometry import Intrinsics, backproject, look_at_pose
+
+    rng = np.random.default_rng(5)
+    K = Intrinsics.from_fov(40, 30, 60.0)
+    T = look_at_pose(np.array([0.3, -0.2, 1.2]), yaw=0.7, pitch=0.3)
+    depth = rng.uniform(0.5, 4.0, (30, 40)).astype(np.float32)
+    depth[0, :5] = 0.0
+    depth[3, 3] = np.nan
+    depth[4, 4] = np.inf
+    depth[5, 5] = 9.0  # beyond max_depth
+    rgb = rng.integers(0, 256, (30, 40, 3)).astype(np.uint8)
+    grid = rng.integers(0, 7, (8, 10))
+    table = rng.standard_normal((7, 4)).astype(np.float32)
+    a = VoxelMap(0.1, (0.0, 0.0, 0.0), feature_dim=4)
+    a.integrate_frame(depth, rgb, K, T, grid, table, sigma=2.0, max_depth=8.0, stride=2)
+    keep = np.zeros((30, 40), bool)
+    keep[::2, ::2] = True
+    pc, flat = backproject(np.where(depth <= 8.0, depth, 0), K, None, keep)
+    v, u = np.divmod(flat, 40)
+    pw = pc.astype(np.float64) @ T[:3, :3].T + T[:3, 3]
+    b = VoxelMap(0.1, (0.0, 0.0, 0.0), feature_dim=4)
+    b.integrate(pw, radial_weight(pc, 2.0), rgb.reshape(-1, 3)[flat], grid[v * 8 // 30, u * 10 // 40].ravel(), table)
+    assert len(a) == len(b) and len(a) > 100
+    s = b.slots(a.coords)
+    np.testing.assert_array_equal(s, np.arange(len(a)))
+    np.testing.assert_allclose(a.weights, b.weights, rtol=1e-5)
+    np.testing.assert_allclose(a.features, b.features, atol=1e-4)
+    np.testing.assert_allclose(a.colors, b.colors, atol=1e-2)
+    with pytest.raises(InputError, match="feature grid"):
+        a.integrate_frame(depth, rgb, K, T, grid + 7, table, sigma=2.0)

@@ -68,11 +68,11 @@ class LabelEmbeddingEncoder(DenseFeatureEncoder):
         z = np.asarray(frame.depth, dtype=np.float64)[np.ix_(vs, us)]
         K = frame.K
         T = np.asarray(frame.T_wc, dtype=np.float64)
-        xc = (us[None, :] - K.cx) / K.fx * z
-        yc = (vs[:, None] - K.cy) / K.fy * z
-        zw = T[2, 0] * xc + T[2, 1] * yc + T[2, 2] * z + T[2, 3]
         stuff = self._lookup([self.floor_label, self.wall_label])
-        with np.errstate(invalid="ignore"):
+        with np.errstate(invalid="ignore"):  # invalid depth (0, NaN, inf) is "wall": it never reaches a voxel
+            xc = (us[None, :] - K.cx) / K.fx * z
+            yc = (vs[:, None] - K.cy) / K.fy * z
+            zw = T[2, 0] * xc + T[2, 1] * yc + T[2, 2] * z + T[2, 3]
             grid = np.where(zw < self.floor_height, stuff[0], stuff[1]).astype(np.intp)
         if detections:
             ids = self._lookup([d.label for d in detections])
