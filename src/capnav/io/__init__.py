@@ -1,1 +1,1 @@
-"""io stage."""
+"""Sources and sinks of posed RGB-D streams (dataset folders) and map files."""

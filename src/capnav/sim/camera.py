@@ -1,9 +1,10 @@
 """OpenGL matrices for pybullet that match an OpenCV pinhole camera exactly, and depth linearisation.
 
 pybullet's renderer takes an OpenGL view matrix (camera x right, y up, looking down -z) and a
-projection matrix, both column-major. A pixel (u, v) of the returned image (row v from the top)
-sees the ray through its centre, which in OpenCV coordinates is ((u - cx) / fx, (v - cy) / fy, 1)
-when the frustum below is used (the +0.5 terms shift GL's pixel-centre convention onto OpenCV's).
+projection matrix, both column-major. Its tiny renderer samples column u at NDC x = 2u/W - 1 and
+row v (counted from the top of the returned image) at NDC y = 1 - 2(v + 1)/H (measured: floor
+depth against the analytic ray-plane hit, tests/sim/test_render.py). The frustum below puts the
+OpenCV ray ((u - cx) / fx, (v - cy) / fy, 1) exactly on those samples.
 """
 
 from __future__ import annotations
@@ -23,13 +24,13 @@ def view_matrix(T_wc: NDArray[np.float64]) -> list[float]:
 
 
 def projection_matrix(K: Intrinsics, near: float, far: float) -> list[float]:
-    """GL projection whose pixel centres reproduce OpenCV's ``u = fx x / z + cx``."""
+    """GL projection whose pixel samples reproduce OpenCV's ``u = fx x / z + cx``, ``v = fy y / z + cy``."""
     W, H = K.width, K.height
     P = np.zeros((4, 4))
     P[0, 0] = 2.0 * K.fx / W
-    P[0, 2] = 1.0 - (2.0 * K.cx + 1.0) / W
+    P[0, 2] = 1.0 - 2.0 * K.cx / W
     P[1, 1] = 2.0 * K.fy / H
-    P[1, 2] = (2.0 * K.cy + 1.0) / H - 1.0
+    P[1, 2] = (2.0 * K.cy + 2.0) / H - 1.0
     P[2, 2] = -(far + near) / (far - near)
     P[2, 3] = -2.0 * far * near / (far - near)
     P[3, 2] = -1.0

@@ -13,6 +13,7 @@ from scipy.sparse.csgraph import dijkstra
 from capnav.core.grid import FREE, OCCUPIED, UNKNOWN, GridSpec, OccupancyGrid
 from capnav.sim.shapes import RectSet
 
+CLEARANCE_CAP = 2.0  # clearances (distance to the nearest obstacle) are exact up to this (m)
 _NEIGHBOURS = ((0, 1, 1.0), (1, 0, 1.0), (1, 1, np.sqrt(2.0)), (1, -1, np.sqrt(2.0)))
 
 
@@ -28,7 +29,8 @@ class NavGrid:
         centres = self.spec.to_world(np.stack([rr.ravel(), cc.ravel()], axis=1))
         inside = ((centres[:, 0] > xmin) & (centres[:, 0] < xmax) & (centres[:, 1] > ymin)
                   & (centres[:, 1] < ymax)).reshape(rr.shape)
-        self.clearance = obstacles.min_distance(centres).reshape(rr.shape)
+        s = self.spec
+        self.clearance = obstacles.distance_grid(s.x0, s.y0, s.resolution, s.rows, s.cols, cap=CLEARANCE_CAP)
         self.inside = inside
         fits = inside & (self.clearance > radius)
         labels, n = ndimage.label(fits, structure=np.ones((3, 3), dtype=bool))

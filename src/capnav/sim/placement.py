@@ -63,6 +63,9 @@ class Placed:
         return float(p[0]), float(p[1])
 
 
+# Pieces that only make sense next to their anchor (no fallback to a free wall spot).
+_ANCHORED_ONLY = ("chair", "nightstand", "coffee table", "stool")
+
 # Wall k of a room: (yaw that turns the front (+y) away from it, which side).
 _WALL_YAW = {"south": 0.0, "north": np.pi, "west": -np.pi / 2, "east": np.pi / 2}
 
@@ -134,7 +137,7 @@ class RoomFiller:
             y = r.center[1] + float(self.rng.uniform(-0.25, 0.25)) * r.h
             yaw = 0.0 if r.w >= r.h else np.pi / 2
             cand = Placed(cat, model, round(x, 3), round(y, 3), yaw + float(self.rng.integers(2)) * np.pi, self.room)
-            if self.ok(cand, margin=0.6):  # leave walking space around free-standing pieces
+            if self.ok(cand, margin=0.45):  # leave walking space around free-standing pieces
                 return cand
         return None
 
@@ -165,6 +168,8 @@ class RoomFiller:
             elif kind == "near":
                 for s in (-1, 1):
                     cands.append((s * (aw / 2 + d / 2 + 0.4), 0.0, s * np.pi / 2))
+                    cands.append((s * (aw / 2 + d / 2 + 0.4), ad / 2, s * np.pi / 2))
+                    cands.append((s * (aw / 2 + d / 2 + 0.4), -ad / 2, s * np.pi / 2))
                 cands.append((0.0, ad / 2 + d / 2 + 0.45, np.pi))
             order = self.rng.permutation(len(cands))
             for k in order:
@@ -177,12 +182,15 @@ class RoomFiller:
         return None
 
     def place(self, cat: str, model: Model, rule: str) -> Placed | None:
+        """Place by ``rule``; pieces that can stand anywhere fall back to a free spot along a wall."""
         if rule in ("wall", "corner"):
-            return self._wall(cat, model, rule == "corner")
-        if rule == "center":
-            return self._center(cat, model)
-        anchor_cat = rule.split(":", 1)[1]
-        anchors = [i for i, p in enumerate(self.placed) if p.category == anchor_cat and p.room == self.room]
-        if not anchors:
-            return None
-        return self._anchored(cat, model, rule, anchors)
+            out = self._wall(cat, model, rule == "corner")
+        elif rule == "center":
+            out = self._center(cat, model)
+        else:
+            anchor_cat = rule.split(":", 1)[1]
+            anchors = [i for i, p in enumerate(self.placed) if p.category == anchor_cat and p.room == self.room]
+            out = self._anchored(cat, model, rule, anchors) if anchors else None
+        if out is None and rule != "wall" and cat not in _ANCHORED_ONLY:
+            out = self._wall(cat, model, False)
+        return out

@@ -80,6 +80,32 @@ class RectSet:
         inside = np.minimum(np.maximum(lx, ly), 0.0)
         return np.asarray(outside + inside)
 
+    def distance_grid(self, x0: float, y0: float, res: float, rows: int, cols: int, cap: float) -> F64:
+        """(rows, cols) distance from each cell centre to the nearest rectangle, capped at ``cap``.
+
+        Each rectangle only touches the cells of its bounding box grown by ``cap``, which makes this
+        far cheaper than ``min_distance`` over all cells.
+        """
+        out = np.full((rows, cols), cap, dtype=np.float64)
+        ext = np.abs(self.half[:, 0] * self.cos) + np.abs(self.half[:, 1] * self.sin), \
+            np.abs(self.half[:, 0] * self.sin) + np.abs(self.half[:, 1] * self.cos)
+        for k in range(len(self)):
+            cx, cy = self.center[k]
+            c0 = max(0, int(np.floor((cx - ext[0][k] - cap - x0) / res)))
+            c1 = min(cols, int(np.ceil((cx + ext[0][k] + cap - x0) / res)) + 1)
+            r0 = max(0, int(np.floor((cy - ext[1][k] - cap - y0) / res)))
+            r1 = min(rows, int(np.ceil((cy + ext[1][k] + cap - y0) / res)) + 1)
+            if c0 >= c1 or r0 >= r1:
+                continue
+            xs = x0 + (np.arange(c0, c1) + 0.5) * res - cx
+            ys = y0 + (np.arange(r0, r1) + 0.5) * res - cy
+            dx, dy = xs[None, :], ys[:, None]
+            lx = np.abs(dx * self.cos[k] + dy * self.sin[k]) - self.half[k, 0]
+            ly = np.abs(-dx * self.sin[k] + dy * self.cos[k]) - self.half[k, 1]
+            d = np.hypot(np.maximum(lx, 0.0), np.maximum(ly, 0.0)) + np.minimum(np.maximum(lx, ly), 0.0)
+            np.minimum(out[r0:r1, c0:c1], d, out=out[r0:r1, c0:c1])
+        return out
+
     def min_distance(self, pts: F64) -> F64:
         """(M,) distance from each point to the nearest rectangle (inf when the set is empty)."""
         pts = np.asarray(pts, dtype=np.float64).reshape(-1, 2)

@@ -57,14 +57,40 @@ def _tiles(a: float, b: float, step: float) -> list[tuple[float, float]]:
     return [(float(edges[i]), float(edges[i + 1])) for i in range(n)]
 
 
+def _connect_quietly() -> tuple[Any, int]:
+    """Import pybullet and open a DIRECT client without its build banner on stdout (the banner would
+    clutter CLI output): C stdout/stderr point at /dev/null and flushed before it is restored."""
+    import ctypes
+    import os
+    import sys
+
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = (os.dup(1), os.dup(2))
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 1)
+            os.dup2(null.fileno(), 2)
+            import pybullet
+
+            client = int(pybullet.connect(pybullet.DIRECT))
+            try:
+                ctypes.CDLL(None).fflush(None)
+            except (OSError, AttributeError):  # no libc symbol table (non-POSIX): the banner may show
+                pass
+    finally:
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        os.close(saved[0])
+        os.close(saved[1])
+    return pybullet, client
+
+
 class BulletWorld:
     """Owns a pybullet DIRECT client with the apartment loaded; close() releases it."""
 
     def __init__(self, apt: Apartment, textures: bool = True, tile: float = 1.0) -> None:
-        import pybullet as p
-
-        self.p = p
-        self.client = p.connect(p.DIRECT)
+        self.p, self.client = _connect_quietly()
         self._tmp = Path(tempfile.mkdtemp(prefix="capnav-tex-"))
         self._tex: dict[tuple[str, RGB], int] = {}
         self.textures = textures

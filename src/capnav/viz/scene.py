@@ -1,0 +1,80 @@
+"""Top-down picture of a simulated apartment: rooms, walls with door gaps, objects labelled."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from capnav.core.atomic import atomic_path
+from capnav.core.grid import FREE, OccupancyGrid
+from capnav.sim.manifest import SceneManifest
+
+_ROOM_TINT = {"living room": "#f3ead8", "kitchen": "#e3eef3", "bedroom": "#efe3ef", "bathroom": "#dff0ea",
+              "office": "#eef0dc", "hallway": "#ececec"}
+
+
+def draw_scene(manifest: SceneManifest, path: str | Path, navigable: OccupancyGrid | None = None,
+               trajectory: NDArray[np.floating] | None = None, title: str | None = None, dpi: int = 110) -> Path:
+    """Save a labelled top-down map (PNG). ``navigable`` shades where the agent fits; ``trajectory``
+    (K, 2+) draws a path. North (+y) is up."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Polygon
+
+    x0, y0, x1, y1 = manifest.bounds
+    w, h = x1 - x0, y1 - y0
+    fig, ax = plt.subplots(figsize=(min(14.0, 1.0 + w * 0.9), min(12.0, 1.0 + h * 0.9)))
+    for room in manifest.rooms:
+        poly = np.asarray(room.polygon)
+        ax.add_patch(Polygon(poly, closed=True, facecolor=_ROOM_TINT.get(room.name, "#eeeeee"), edgecolor="none"))
+        cx = float(poly[:, 0].mean())
+        ax.text(cx, poly[:, 1].max() - 0.25, f"{room.name} ({room.id})", ha="center", va="top", fontsize=8,
+                color="#555555", style="italic")
+    if navigable is not None:
+        free = np.ma.masked_where(navigable.cells != FREE, np.ones(navigable.cells.shape))
+        s = navigable.spec
+        ax.imshow(free, origin="lower", extent=(s.x0, s.x0 + s.cols * s.resolution, s.y0, s.y0 + s.rows * s.resolution),
+                  cmap="Greens", vmin=0, vmax=2, alpha=0.3, interpolation="nearest")
+    for room in manifest.rooms:  # walls
+        poly = np.asarray(room.polygon + room.polygon[:1])
+        ax.plot(poly[:, 0], poly[:, 1], color="#333333", lw=2.5, solid_capstyle="butt")
+    for door in manifest.doors:
+        a, b = _door_ends(door.center, door.width, manifest)
+        ax.plot([a[0], b[0]], [a[1], b[1]], color="white", lw=4.0, solid_capstyle="butt")
+    for o in manifest.objects:
+        fp = np.asarray(o.footprint)
+        ax.add_patch(Polygon(fp, closed=True, facecolor=np.asarray(o.color_rgb) / 255.0, edgecolor="black",
+                             lw=0.6, alpha=0.9))
+        ax.text(o.center[0], o.center[1], f"{o.id} {o.category}", ha="center", va="center", fontsize=6,
+                bbox={"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none", "alpha": 0.7})
+    if trajectory is not None and len(trajectory) > 0:
+        t = np.asarray(trajectory)
+        ax.plot(t[:, 0], t[:, 1], color="#d62728", lw=1.0, alpha=0.8)
+        ax.plot(t[0, 0], t[0, 1], "o", color="#d62728", ms=4)
+    ax.set_xlim(x0 - 0.2, x1 + 0.2)
+    ax.set_ylim(y0 - 0.2, y1 + 0.2)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title(title or f"apartment seed {manifest.seed}: {len(manifest.rooms)} rooms, "
+                 f"{len(manifest.objects)} objects", fontsize=10)
+    fig.tight_layout()
+    out = Path(path)
+    with atomic_path(out, suffix=".png") as tmp:
+        fig.savefig(tmp, dpi=dpi, format="png")
+    plt.close(fig)
+    return out
+
+
+def _door_ends(center: tuple[float, float], width: float, m: SceneManifest) -> tuple[tuple[float, float], ...]:
+    """A door lies on a wall of constant x or y: find which by checking the room edges."""
+    cx, cy = center
+    for room in m.rooms:
+        xs = [p[0] for p in room.polygon]
+        if min(abs(cx - min(xs)), abs(cx - max(xs))) < 1e-6:
+            return (cx, cy - width / 2), (cx, cy + width / 2)
+    return (cx - width / 2, cy), (cx + width / 2, cy)
