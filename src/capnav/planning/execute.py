@@ -9,7 +9,7 @@ agent stands, up to ``max_replans`` times.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -76,20 +76,23 @@ def navigate_to(agent: StepAgent, occ: OccupancyGrid, target_footprint: NDArray[
     """
     cfg = config or PlannerConfig()
     fp = check_footprint(target_footprint)
-    cm = build_costmap(occ, cfg) if costmap is None else Costmap(
-        OccupancyGrid(costmap.spec, costmap.occ.cells.copy()), costmap.weights.copy())
+    events: list[str] = []
+    radius = _agent_radius(agent)
+    if radius is not None and radius > cfg.robot_radius:
+        # Planning for a thinner robot than the one driving would graze every wall.
+        cfg = replace(cfg, robot_radius=radius)
+        events.append(f"robot_radius raised to the agent's {radius:.2f} m")
+        costmap = None
+    levels = _Levels(occ, cfg, costmap)
     log = _Log(agent, cfg.max_steps)
     goal: GoalPose | None = None
     plans: list[PlannedPath] = []
-    events: list[str] = []
     replans = 0
     reason = ""
     first = True
     while True:
-        here = log.xy()
         try:
-            goal = select_goal(cm.occ, fp, here, cfg, cm)
-            plan = plan_path(cm.occ, here, goal.xy, cfg, cm)
+            goal, plan, note = levels.plan(fp, log.xy())
         except CapNavError as e:
             if first:
                 raise
@@ -97,13 +100,13 @@ def navigate_to(agent: StepAgent, occ: OccupancyGrid, target_footprint: NDArray[
             break
         first = False
         plans.append(plan)
-        events.extend(plan.notes)
+        events.extend([*plan.notes, *([note] if note else [])])
         blocked_at = _follow(agent, plan.waypoints, cfg, log)
         if blocked_at is None:
             _face(agent, goal.yaw, log)
             reason = goal.reason
             break
-        n = mark_blocked(cm, blocked_at, cfg.blocked_mark_radius, cfg)
+        n = levels.mark(blocked_at)
         replans += 1
         events.append(f"contact near ({blocked_at[0]:.2f}, {blocked_at[1]:.2f}); {n} cells blocked; replanning")
         if replans > cfg.max_replans:
@@ -117,6 +120,61 @@ def navigate_to(agent: StepAgent, occ: OccupancyGrid, target_footprint: NDArray[
     return NavResult(reached, (pose[0], pose[1], pose[2]), log.length, replans,
                      plans[-1].waypoints if plans else np.empty((0, 2)), reason, goal, dist, log.array(), plans,
                      events)
+
+
+class _Levels:
+    """The costmaps of the configured inflation and of its relaxations, sharing contact marks.
+
+    Level 0 is the config. When it leaves the object out of reach (a gap narrower than the robot
+    plus margin, or the start boxed in by the inflation), ``config.relax`` allows two more: the
+    bare robot radius, then the radius less half a cell (a grid cell whose centre is clear may
+    still fit the robot: the grid is coarser than the geometry). Contacts will tell if not.
+    """
+
+    def __init__(self, occ: OccupancyGrid, cfg: PlannerConfig, costmap: Costmap | None) -> None:
+        self.cfgs = [cfg]
+        if cfg.relax:
+            half = 0.5 * occ.spec.resolution
+            if cfg.safety_margin > 0:
+                self.cfgs.append(replace(cfg, safety_margin=0.0))
+            if cfg.robot_radius > half:
+                self.cfgs.append(replace(cfg, safety_margin=0.0, robot_radius=cfg.robot_radius - half))
+        base = build_costmap(occ, cfg) if costmap is None else costmap
+        # Private copies: contact marks must not leak into the caller's map.
+        self.maps = {0: Costmap(OccupancyGrid(base.spec, base.occ.cells.copy()), base.weights.copy())}
+
+    def _map(self, i: int) -> Costmap:
+        if i not in self.maps:  # built lazily from level 0's grid, so it carries the marks so far
+            self.maps[i] = build_costmap(self.maps[0].occ, self.cfgs[i])
+        return self.maps[i]
+
+    def plan(self, fp: NDArray[np.float64], here: tuple[float, float]) -> tuple[GoalPose, PlannedPath, str]:
+        """Goal and path at the strictest level that gets within reach (else level 0's fallback)."""
+        fallback: tuple[GoalPose, PlannedPath, str] | None = None
+        error: CapNavError | None = None
+        for i, cfg in enumerate(self.cfgs):
+            cm = self._map(i)
+            try:
+                goal = select_goal(cm.occ, fp, here, cfg, cm)
+                plan = plan_path(cm.occ, here, goal.xy, cfg, cm)
+            except CapNavError as e:
+                error = error or e
+                continue
+            note = "" if i == 0 else (f"relaxed inflation to {cfg.inflation:.3f} m: nothing within reach at "
+                                      f"{self.cfgs[0].inflation:.3f} m")
+            if goal.reached_within_reach:
+                return goal, plan, note
+            fallback = fallback or (goal, plan, note)
+        if fallback is not None:
+            return fallback
+        assert error is not None
+        raise error
+
+    def mark(self, xy: NDArray[np.float64]) -> int:
+        n = 0
+        for i, cm in self.maps.items():
+            n = max(n, mark_blocked(cm, xy, self.cfgs[i].blocked_mark_radius, self.cfgs[i]))
+        return n
 
 
 class _Log:
@@ -176,9 +234,15 @@ def _contact_point(agent: StepAgent, target: NDArray[np.float64], cfg: PlannerCo
     return np.array([x, y]) + u * (cfg.robot_radius + cfg.blocked_mark_radius)
 
 
+def _agent_radius(agent: object) -> float | None:
+    ac = getattr(agent, "cfg", None) or getattr(agent, "config", None)
+    r = getattr(ac, "radius", None)
+    return float(r) if isinstance(r, (int, float)) else None
+
+
 def _motion(agent: object) -> tuple[float, float]:
     """The agent's forward step (m) and turn angle (rad), from its config when it has one."""
-    ac = getattr(agent, "config", None)
+    ac = getattr(agent, "cfg", None) or getattr(agent, "config", None)
     step = float(getattr(ac, "forward_step", 0.25))
     turn = math.radians(float(getattr(ac, "turn_deg", 30.0)))
     return step, turn
