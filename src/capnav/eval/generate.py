@@ -141,28 +141,35 @@ def description_targets(truth: SceneTruth) -> list[int]:
 def description_episodes(truth: SceneTruth, describe: Describe, rng: np.random.Generator,
                          cfg: EpisodeConfig | None = None, id_prefix: str = "") -> list[Episode]:
     """Description episodes: one described instance per subgoal, preferring instances with lookalikes;
-    no instance twice in an episode and no category twice in a row."""
+    no instance twice in an episode and no category twice in a row. An instance that the describer
+    can only name by its bare category (nothing singles it out) is skipped: under this protocol
+    only the described instance counts, so its text must identify it."""
     cfg = cfg or EpisodeConfig()
     pool = description_targets(truth)
     if not pool:
         raise DatasetError(f"scene {truth.scene_seed} has no objects to describe")
+    lookalikes = {c for c in truth.categories.values() if len(truth.instances_of(c)) >= 2}
     episodes: list[Episode] = []
     for k in range(cfg.episodes_per_scene):
         for _ in range(cfg.max_tries):
-            ids: list[int] = []
-            for _g in range(cfg.subgoals):
+            start = truth.sample_start(rng)
+            goals: list[tuple[int, str, str]] = []  # (instance, text, kind)
+            for j in range(cfg.subgoals):
+                ids = [g[0] for g in goals]
                 choices = [i for i in pool if i not in ids
                            and (not ids or truth.categories[i] != truth.categories[ids[-1]])] or pool
-                ids.append(choices[int(rng.integers(len(choices)))])
-            start = truth.sample_start(rng)
-            if _valid_chain(truth, start, [[i] for i in ids], cfg):
+                for i in (choices[int(c)] for c in rng.permutation(len(choices))):
+                    text, kind = describe(i, (start.x, start.y) if j == 0 else None, rng)
+                    if kind != "category" or truth.categories[i] not in lookalikes:
+                        goals.append((i, text, kind))
+                        break
+                else:
+                    break  # nothing describable left for this slot: draw another episode
+            if len(goals) == cfg.subgoals and _valid_chain(truth, start, [[g[0]] for g in goals], cfg):
                 break
         else:
             raise DatasetError(f"scene {truth.scene_seed}: no valid description episode in {cfg.max_tries} tries")
-        subgoals = []
-        for j, i in enumerate(ids):
-            text, kind = describe(i, (start.x, start.y) if j == 0 else None, rng)
-            subgoals.append(Subgoal(text=text, category=truth.categories[i], target_ids=[i], kind=kind))
-        episodes.append(Episode(id=f"{id_prefix}s{truth.scene_seed}-desc-{k}", scene_seed=truth.scene_seed,
-                                start=start, subgoals=subgoals))
+        episodes.append(Episode(
+            id=f"{id_prefix}s{truth.scene_seed}-desc-{k}", scene_seed=truth.scene_seed, start=start,
+            subgoals=[Subgoal(text=t, category=truth.categories[i], target_ids=[i], kind=kd) for i, t, kd in goals]))
     return episodes

@@ -1,0 +1,56 @@
+"""``capnav eval``: the multi-object navigation benchmark (label-only and description protocols)."""
+
+from __future__ import annotations
+
+import shlex
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("eval")
+    def eval_(
+        scenes: Annotated[int, typer.Option(help="number of apartments (the paper: 10)")] = 10,
+        episodes_per_scene: Annotated[int, typer.Option(help="episodes per apartment and protocol")] = 9,
+        seed: Annotated[int, typer.Option(help="run seed: apartments, episodes, detector noise")] = 0,
+        methods: Annotated[str, typer.Option(help="comma-separated method names, or 'all' (every registered one)")
+                           ] = "all",
+        protocols: Annotated[str, typer.Option(help="comma-separated: label, description")] = "label,description",
+        workers: Annotated[int, typer.Option(help="local worker processes (one apartment per task)")] = 2,
+        out: Annotated[Path, typer.Option("--out", "-o", help="run folder")] = Path("runs/eval"),
+        ray: Annotated[str | None, typer.Option(
+            "--ray", help="run the apartments on a Ray cluster at this address ('local' starts one)")] = None,
+        episodes: Annotated[Path | None, typer.Option(
+            help="folder with <protocol>.json episode files of an earlier run, to rerun exactly")] = None,
+        width: Annotated[int, typer.Option(help="camera width (pixels)")] = 320,
+        height: Annotated[int, typer.Option(help="camera height (pixels)")] = 240,
+        max_frames: Annotated[int | None, typer.Option(help="use at most this many exploration frames")] = None,
+        pictures: Annotated[int, typer.Option(help="failure pictures per method, protocol and apartment")] = 1,
+        progress: Annotated[bool, typer.Option(help="show progress")] = True,
+    ) -> None:
+        """Run every method on the same apartments, maps and episodes; write results.json and report.md."""
+        from rich.console import Console
+
+        from capnav.eval.benchmark import run_benchmark
+        from capnav.eval.episodes import parse_protocols
+        from capnav.eval.method import load_methods
+        from capnav.eval.pipeline import PipelineConfig
+        from capnav.eval.scene_task import DEFAULT_METHODS, EvalConfig
+
+        if methods == "all":
+            names = DEFAULT_METHODS + tuple(m for m in load_methods() if m not in DEFAULT_METHODS)
+        else:
+            names = tuple(m.strip() for m in methods.split(",") if m.strip())
+        cfg = EvalConfig(scenes=scenes, episodes_per_scene=episodes_per_scene, seed=seed, methods=names,
+                         protocols=tuple(parse_protocols(protocols)), pictures_per_scene=pictures,
+                         pipeline=PipelineConfig(width=width, height=height, max_frames=max_frames))
+        res = run_benchmark(cfg, out, workers=workers, ray_address=ray, episodes_dir=episodes, progress=progress,
+                            command=" ".join(["capnav", *map(shlex.quote, sys.argv[1:])]))
+        con = Console()
+        for s in res.summaries:
+            con.print(f"{s.method:>20} {s.protocol:>11}: in a row {' / '.join(f'{100 * v:.0f}' for v in s.in_a_row)}"
+                      f", indep. {100 * s.independent:.1f}%, SPL {100 * s.spl:.1f}")
+        con.print(f"{len(res.records)} subgoals in {res.seconds:.0f} s; report: {res.out / 'report.md'}")

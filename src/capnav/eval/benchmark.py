@@ -1,0 +1,138 @@
+"""The whole benchmark: one task per apartment (local processes or Ray), then results and report.
+
+Run folder layout::
+
+    OUT/config.json                 the run's settings, seed, version, commit, command
+    OUT/episodes/<protocol>.json    the episode files (rerun exactly with --episodes OUT/episodes)
+    OUT/scenes/<seed>/map.capnav    the apartment's prior map (built once, shared by all methods)
+    OUT/scenes/<seed>/result.json   that apartment's records and timings
+    OUT/logs/<method>/<protocol>/<episode>.json   per-episode logs with trajectories
+    OUT/pictures/*.png              failure cases
+    OUT/records.jsonl               every scored subgoal (no trajectories)
+    OUT/results.json                summaries per (method, protocol), timings, config
+    OUT/report.md                   Table 1, Table 2 and the description table, paper beside ours
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import time
+from collections import defaultdict
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from capnav.core.atomic import write_json, write_text
+from capnav.core.errors import InputError
+from capnav.eval.episodes import EpisodeSet
+from capnav.eval.method import load_methods
+from capnav.eval.metrics import SubgoalRecord, Summary, summarize_all
+from capnav.eval.parallel import run_tasks
+from capnav.eval.report import render
+from capnav.eval.scene_task import EvalConfig, SceneTask, run_scene
+
+
+@dataclass
+class BenchmarkResult:
+    out: Path
+    summaries: list[Summary]
+    records: list[SubgoalRecord]
+    seconds: float
+
+    def summary(self, method: str, protocol: str) -> Summary:
+        for s in self.summaries:
+            if s.method == method and s.protocol == protocol:
+                return s
+        raise InputError(f"no results for {method} / {protocol}")
+
+
+def _version() -> tuple[str, str]:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        v = version("capnav")
+    except PackageNotFoundError:  # pragma: no cover - running from a source tree
+        v = "unknown"
+    try:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                                cwd=Path(__file__).parent, timeout=5).stdout.strip() or "unknown"
+    except (OSError, subprocess.SubprocessError):
+        commit = "unknown"
+    return v, commit
+
+
+def load_episode_dir(path: Path, protocols: tuple[str, ...]) -> dict[str, EpisodeSet]:
+    """Episode files ``<protocol>.json`` of an earlier run, validated (``DatasetError`` if bad)."""
+    sets: dict[str, EpisodeSet] = {}
+    for p in protocols:
+        es = EpisodeSet.load(path / f"{p}.json")
+        if es.protocol != p:
+            raise InputError(f"{path / f'{p}.json'} holds {es.protocol!r} episodes, not {p!r}")
+        sets[p] = es
+    return sets
+
+
+def run_benchmark(config: EvalConfig, out: str | Path, workers: int = 1, ray_address: str | None = None,
+                  episodes_dir: str | Path | None = None, progress: bool = True, command: str = "") -> BenchmarkResult:
+    """Evaluate ``config.methods`` on both protocols over ``config.scenes`` apartments."""
+    t0 = time.perf_counter()
+    out = Path(out)
+    known = load_methods()
+    unknown = [m for m in config.methods if m not in known]
+    if unknown:
+        raise InputError(f"unknown method(s) {', '.join(unknown)}; available: {', '.join(known)}")
+    given: dict[str, EpisodeSet] = {}
+    scene_seeds = config.scene_seeds()
+    if episodes_dir is not None:
+        given = load_episode_dir(Path(episodes_dir), config.protocols)
+        scene_seeds = sorted({s for es in given.values() for s in es.scene_seeds})
+    version, commit = _version()
+    meta = {"version": version, "commit": commit, "seed": config.seed, "scenes": len(scene_seeds),
+            "scene_seeds": scene_seeds, "episodes_per_scene": config.episodes_per_scene,
+            "detector": f"{config.pipeline.detector}:{config.pipeline.detector_noise}",
+            "embedder": config.pipeline.embedder, "command": command or "capnav eval", "workers": workers,
+            "ray": ray_address, "config": asdict(config)}
+    write_json(out / "config.json", meta)
+    tasks = [SceneTask(config, s, str(out), {p: [e.model_dump() for e in es.for_scene(s)] for p, es in given.items()}
+                       or None) for s in scene_seeds]
+    results = run_tasks(run_scene, tasks, workers=workers, ray_address=ray_address, progress=progress)
+    for res in results:
+        write_json(out / "scenes" / str(res["scene_seed"]) / "result.json", res)
+
+    if not given:  # save the generated episodes so that anyone can rerun exactly
+        for p in config.protocols:
+            es = EpisodeSet(protocol=p, seed=config.seed, scene_seeds=scene_seeds,  # type: ignore[arg-type]
+                            generator={"episodes_per_scene": config.episodes_per_scene, "subgoals": config.subgoals,
+                                       "version": version},
+                            episodes=[e for res in results for e in res["episodes"][p]])
+            es.save(out / "episodes" / f"{p}.json")
+
+    records = [SubgoalRecord.from_dict(d) for res in results for d in res["records"]]
+    write_text(out / "records.jsonl", "".join(json.dumps({k: v for k, v in r.to_dict().items()
+                                                          if k != "trajectory"}) + "\n" for r in records))
+    summaries = summarize_all(records)
+    timings: dict[str, float] = defaultdict(float)
+    for res in results:
+        for k, v in res["timings"].items():
+            timings[k] += float(v)
+    seconds = time.perf_counter() - t0
+    timings["wall clock (whole run)"] = seconds
+    failures = [f for res in results for f in res["failures"]]
+    write_json(out / "results.json", {**meta, "seconds": seconds, "timings": dict(timings),
+                                      "summaries": [s.to_dict() for s in summaries],
+                                      "maps": {str(r["scene_seed"]): r["map"] for r in results}})
+    write_text(out / "report.md", render(summaries, meta, _pick_failures(failures), timings))
+    return BenchmarkResult(out, summaries, records, seconds)
+
+
+def _pick_failures(failures: list[dict[str, Any]], per_method: int = 3) -> list[dict[str, Any]]:
+    """A few failures per (method, protocol) for the report, pictures first."""
+    chosen: list[dict[str, Any]] = []
+    count: dict[tuple[str, str], int] = defaultdict(int)
+    for f in sorted(failures, key=lambda f: (not f["picture"], f["method"], f["protocol"], f["episode_id"])):
+        key = (f["method"], f["protocol"])
+        if count[key] < per_method:
+            count[key] += 1
+            chosen.append(f)
+    return sorted(chosen, key=lambda f: (f["method"], f["protocol"], f["episode_id"], f["index"]))

@@ -1,0 +1,158 @@
+"""Evaluate every method on every episode of ONE apartment (the unit of parallel work).
+
+A task opens the apartment, builds or loads its prior map (once, shared by all map-based methods),
+generates or takes its episodes, runs each method through each episode with the same start poses,
+writes the per-episode logs and a few failure pictures, and returns JSON-able results. Tasks are
+independent and deterministic, so a run's numbers do not depend on how tasks were scheduled.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from capnav.core.atomic import write_json
+from capnav.eval.episode_runner import run_episode
+from capnav.eval.episodes import PROTOCOLS, Episode, check_against_manifest
+from capnav.eval.generate import EpisodeConfig, description_episodes, label_episodes
+from capnav.eval.method import SceneContext, create_method
+from capnav.eval.metrics import SubgoalRecord
+from capnav.eval.pipeline import PipelineConfig, SceneAssets, open_scene
+
+#: Every method of the benchmark, in report order (exploration baselines join when registered).
+DEFAULT_METHODS: tuple[str, ...] = ("random-object", "category-only", "vlmaps", "capnav-no-verify",
+                                    "capnav-no-heuristic", "capnav")
+
+
+@dataclass(frozen=True)
+class EvalConfig:
+    """Everything that defines a benchmark run (the paper's setup as defaults)."""
+
+    scenes: int = 10
+    episodes_per_scene: int = 9
+    seed: int = 0
+    methods: tuple[str, ...] = DEFAULT_METHODS
+    protocols: tuple[str, ...] = PROTOCOLS
+    subgoals: int = 4
+    pipeline: PipelineConfig = field(default_factory=PipelineConfig)
+    max_steps: int = 500  # motion budget per subgoal for step-driven methods
+    pictures_per_scene: int = 1  # failure pictures per (method, protocol) and apartment
+    method_options: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+    def scene_seeds(self) -> list[int]:
+        return [1000 * self.seed + i for i in range(self.scenes)]
+
+    def episode_config(self) -> EpisodeConfig:
+        return EpisodeConfig(episodes_per_scene=self.episodes_per_scene, subgoals=self.subgoals)
+
+
+@dataclass(frozen=True)
+class SceneTask:
+    config: EvalConfig
+    scene_seed: int
+    out: str  # run folder
+    episodes: dict[str, list[dict[str, Any]]] | None = None  # protocol -> episodes given by the user
+    progress: bool = False
+
+
+def generate_scene_episodes(assets: SceneAssets, config: EvalConfig, protocol: str) -> list[Episode]:
+    """The seeded episodes of one apartment and protocol."""
+    rng = np.random.default_rng([config.seed, assets.scene_seed, PROTOCOLS.index(protocol)])
+    if protocol == "label":
+        return label_episodes(assets.truth, rng, config.episode_config())
+    from capnav.eval.instructions import InstructionGenerator
+
+    describe = InstructionGenerator(assets.sim.manifest).describe
+    return description_episodes(assets.truth, describe, rng, config.episode_config())
+
+
+def run_scene(task: SceneTask) -> dict[str, Any]:
+    """Run one apartment; returns {"scene_seed", "episodes", "records", "timings", "failures", "map"}."""
+    cfg = task.config
+    out = Path(task.out)
+    folder = out / "scenes" / str(task.scene_seed)
+    assets = open_scene(task.scene_seed, cfg.seed, cfg.pipeline, folder)
+    try:
+        return _run(task, cfg, out, assets)
+    finally:
+        assets.sim.close()
+
+
+def _run(task: SceneTask, cfg: EvalConfig, out: Path, assets: SceneAssets) -> dict[str, Any]:
+    timings = assets.timings
+    t0 = time.perf_counter()
+    episodes: dict[str, list[Episode]] = {}
+    for protocol in cfg.protocols:
+        given = (task.episodes or {}).get(protocol)
+        if given is not None:
+            episodes[protocol] = [Episode.model_validate(e) for e in given]
+            check_against_manifest(episodes[protocol], assets.sim.manifest)
+        else:
+            episodes[protocol] = generate_scene_episodes(assets, cfg, protocol)
+    timings["episodes"] = time.perf_counter() - t0
+
+    methods = [create_method(m, **cfg.method_options.get(m, {})) for m in cfg.methods]
+    cmap = assets.prior_map() if any(m.uses_prior_map for m in methods) else None
+    ctx = SceneContext(scene_seed=assets.scene_seed, seed=cfg.seed, sim=assets.sim, embedder=assets.embedder,
+                       detector=assets.detector, prior_map=cmap, occupancy=cmap.occupancy if cmap else None,
+                       frames=LazyStream(assets), workdir=assets.folder, max_steps=cfg.max_steps)
+    records: list[SubgoalRecord] = []
+    failures: list[dict[str, Any]] = []
+    for method in methods:
+        t_m = time.perf_counter()
+        for protocol in cfg.protocols:
+            pictures = 0
+            for ep in episodes[protocol]:
+                recs = run_episode(method, ctx, ep, assets.truth, protocol)
+                records.extend(recs)
+                write_json(out / "logs" / method.name / protocol / f"{ep.id}.json",
+                           {"episode": ep.model_dump(), "subgoals": [r.to_dict() for r in recs]})
+                for r in recs:
+                    if not r.success and pictures < cfg.pictures_per_scene:
+                        pictures += 1
+                        failures.append(_failure(r, assets, cmap, out))
+        timings[f"method:{method.name}"] = time.perf_counter() - t_m
+    return {
+        "scene_seed": assets.scene_seed,
+        "episodes": {p: [e.model_dump() for e in eps] for p, eps in episodes.items()},
+        "records": [r.to_dict() for r in records],
+        "timings": timings,
+        "failures": failures,
+        "map": None if cmap is None else {"objects": len(cmap.objects), "instances": len(assets.truth.categories),
+                                          "frames": cmap.meta.get("frames_used")},
+    }
+
+
+class LazyStream:
+    """The exploration stream for methods that read frames, regenerated only if one asks."""
+
+    def __init__(self, assets: SceneAssets) -> None:
+        self._assets = assets
+
+    def __len__(self) -> int:
+        return len(self._assets.stream())
+
+    def frame(self, index: int) -> Any:
+        return self._assets.stream().frame(index)
+
+    def __iter__(self) -> Any:
+        return iter(self._assets.stream())
+
+
+def _failure(r: SubgoalRecord, assets: SceneAssets, cmap: Any, out: Path) -> dict[str, Any]:
+    """A failure case for the report, with a top-down picture when the map exists."""
+    item: dict[str, Any] = {"method": r.method, "protocol": r.protocol, "episode_id": r.episode_id, "index": r.index,
+                            "text": r.text, "reason": r.reason, "distance_to_goal": r.distance_to_goal,
+                            "picture": ""}
+    if cmap is None:
+        return item
+    from capnav.eval.pictures import draw_failure
+
+    rel = Path("pictures") / f"{r.method}-{r.protocol}-{r.episode_id}-{r.index}.png"
+    draw_failure(r, assets, cmap, out / rel)
+    item["picture"] = str(rel)
+    return item
