@@ -26,7 +26,7 @@ class PlannerConfig:
     simplify: bool = True  # line-of-sight simplification of the cell path into waypoints
     escape_radius: float = 0.5  # m, a start inside the inflation band snaps to a free cell this close
     relax: bool = True  # out of reach? retry with the bare radius, then the radius less half a cell
-    max_replans: int = 12  # collisions tolerated during execution before giving up
+    max_replans: int = 20  # collisions tolerated during execution before giving up
     blocked_mark_radius: float = 0.08  # m, obstacle disk stamped ahead of the agent on a collision
     max_steps: int = 2000  # discrete-action budget when the agent has no move_to
 

@@ -107,6 +107,12 @@ def navigate_to(agent: StepAgent, occ: OccupancyGrid, target_footprint: NDArray[
             reason = goal.reason
             break
         n = levels.mark(blocked_at)
+        here = np.asarray(log.xy()).reshape(1, 2)
+        if footprint_distance(here, fp)[0] <= cfg.reach - cfg.goal_margin:
+            _face(agent, goal.yaw, log)
+            reason = "stopped within reach after a contact (the map missed an obstacle near the object)"
+            events.append(f"contact near ({blocked_at[0]:.2f}, {blocked_at[1]:.2f}) within reach; stopping")
+            break
         replans += 1
         events.append(f"contact near ({blocked_at[0]:.2f}, {blocked_at[1]:.2f}); {n} cells blocked; replanning")
         if replans > cfg.max_replans:

@@ -1,0 +1,126 @@
+"""Execution in the simulator: the agent reaches instances, logs its trajectory and recovers
+from obstacles the map does not know about."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from capnav.core.errors import InputError
+from capnav.core.grid import FREE, OccupancyGrid
+from capnav.eval.success import footprint_distance
+from capnav.planning import PlannerConfig, build_costmap, navigate_to
+from capnav.sim import Simulator
+
+SEED = 1
+
+
+@pytest.fixture(scope="module")
+def sim():
+    s = Simulator.from_seed(SEED)
+    yield s
+    s.close()
+
+
+def dist_to(agent, fp) -> float:
+    return float(footprint_distance(np.asarray(agent.pose[:2]).reshape(1, 2), fp)[0])
+
+
+def test_reaches_instances_on_the_true_map(sim) -> None:
+    occ = sim.obstacles()
+    cfg = PlannerConfig()
+    cm = build_costmap(occ, cfg)
+    rng = np.random.default_rng(0)
+    for inst in sim.manifest.objects[::4]:
+        fp = np.asarray(inst.footprint)
+        x, y = sim.random_navigable_point(rng)
+        agent = sim.spawn_agent(x, y, 0.0)
+        res = navigate_to(agent, occ, fp, cfg, cm)
+        assert res.reached, (inst.id, res.reason)
+        assert dist_to(agent, fp) <= 1.0
+        assert res.final_pose == pytest.approx(agent.pose)
+        # The log is the agent's own motion: same start, same end, same length.
+        assert np.allclose(res.trajectory[0], (x, y)) and np.allclose(res.trajectory[-1], agent.pose[:2])
+        assert res.path_length == pytest.approx(agent.path_length, abs=1e-6)
+        assert res.path_length >= np.linalg.norm(np.diff(res.waypoints, axis=0), axis=1).sum() - 1e-6
+        assert agent.collisions == 0
+        # Facing the object at the end (within half a turn step).
+        centre = fp.mean(axis=0)
+        want = np.arctan2(centre[1] - agent.pose[1], centre[0] - agent.pose[0])
+        assert abs((agent.pose[2] - want + np.pi) % (2 * np.pi) - np.pi) <= np.radians(15) + 0.05
+        json.dumps(res.to_dict())
+
+
+def furniture_free(sim, every: int = 3) -> OccupancyGrid:
+    """The true map with every ``every``-th piece of furniture erased: obstacles the map missed."""
+    occ = sim.obstacles()
+    rr, cc = np.mgrid[0:occ.spec.rows, 0:occ.spec.cols]
+    centres = occ.spec.to_world(np.stack([rr.ravel(), cc.ravel()], axis=1))
+    cells = occ.cells.copy().ravel()
+    for inst in sim.manifest.objects[::every]:
+        inside = footprint_distance(centres, np.asarray(inst.footprint)) <= occ.spec.resolution
+        cells[inside] = FREE
+    return OccupancyGrid(occ.spec, cells.reshape(occ.cells.shape))
+
+
+def test_collisions_mark_the_map_and_replan(sim) -> None:
+    occ = furniture_free(sim)
+    cfg = PlannerConfig()
+    rng = np.random.default_rng(1)
+    total_replans, reached = 0, 0
+    targets = [o for i, o in enumerate(sim.manifest.objects) if i % 3 != 0]
+    for inst in targets:
+        fp = np.asarray(inst.footprint)
+        x, y = sim.random_navigable_point(rng)
+        agent = sim.spawn_agent(x, y, 0.0)
+        res = navigate_to(agent, occ, fp, cfg)
+        total_replans += res.replans
+        assert res.replans == agent.collisions  # every contact led to one replan
+        assert sum("contact near" in e for e in res.events) == res.replans
+        reached += dist_to(agent, fp) <= 1.0
+    assert total_replans > 0  # the furniture really was in the way
+    assert reached == len(targets)
+    # The caller's map is untouched by the contact marks.
+    assert (occ.cells == furniture_free(sim).cells).all()
+
+
+class StepOnly:
+    """The simulator agent seen through discrete actions only (a robot without a waypoint follower)."""
+
+    def __init__(self, agent) -> None:
+        self._agent = agent
+        self.cfg = agent.cfg
+
+    @property
+    def pose(self):
+        return self._agent.pose
+
+    def step(self, action: str) -> bool:
+        return self._agent.step(action)
+
+
+def test_discrete_actions_reach_the_goal(sim) -> None:
+    occ = sim.obstacles()
+    rng = np.random.default_rng(2)
+    inst = sim.manifest.objects[3]
+    x, y = sim.random_navigable_point(rng)
+    agent = sim.spawn_agent(x, y, 0.0)
+    res = navigate_to(StepOnly(agent), occ, np.asarray(inst.footprint), PlannerConfig())
+    assert res.reached and dist_to(agent, np.asarray(inst.footprint)) <= 1.0
+    assert agent.steps > 3 and res.path_length == pytest.approx(agent.path_length, abs=1e-6)
+
+
+def test_start_inside_an_obstacle_is_an_input_error(sim) -> None:
+    occ = sim.obstacles()
+    inst = sim.manifest.objects[0]
+
+    class Stuck:
+        pose = (float(inst.center[0]), float(inst.center[1]), 0.0)
+
+        def step(self, action: str) -> bool:
+            raise AssertionError("must not move")
+
+    with pytest.raises(InputError, match="inside an obstacle"):
+        navigate_to(Stuck(), occ, np.asarray(sim.manifest.objects[1].footprint))
