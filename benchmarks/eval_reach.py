@@ -117,7 +117,7 @@ def main() -> None:
                 print(f"#   fail: {f}")
         sim.close()
     print()
-    print("| seed | occupancy | reachable / instances | trials | success % | replans | collisions | ms / nav |")
+    print("| seed | occupancy | reachable / instances | trials | success % | replans | contacts (incl. probes) | ms / nav |")
     print("|---:|---|---:|---:|---:|---:|---:|---:|")
     print("\n".join(rows))
     for kind, (ok, n) in totals.items():

@@ -27,12 +27,13 @@ class PlannerConfig:
     escape_radius: float = 0.5  # m, a start inside the inflation band snaps to a free cell this close
     relax: bool = True  # out of reach? retry with the bare radius, then the radius less half a cell
     max_replans: int = 20  # collisions tolerated during execution before giving up
+    probe_step: float = 0.03  # m, bumper probe after a contact (0 = assume the obstacle is ahead)
     blocked_mark_radius: float = 0.08  # m, obstacle disk stamped ahead of the agent on a collision
     max_steps: int = 2000  # discrete-action budget when the agent has no move_to
 
     def __post_init__(self) -> None:
         for name in ("robot_radius", "safety_margin", "goal_margin", "escape_radius", "blocked_mark_radius",
-                     "clearance_band", "clearance_cost"):
+                     "clearance_band", "clearance_cost", "probe_step"):
             v = getattr(self, name)
             if not v >= 0.0:
                 raise InputError(f"PlannerConfig.{name} must be >= 0, got {v}")

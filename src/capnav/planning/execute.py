@@ -177,9 +177,17 @@ class _Levels:
         raise error
 
     def mark(self, xy: NDArray[np.float64]) -> int:
+        """Block a contact on every level, grown by the full robot radius + margin even on relaxed
+        levels (a contact is proof the relaxation was too optimistic there). When that adds
+        nothing the obstacle must be larger than the mark: grow it, so a replan never repeats."""
+        radius = self.cfgs[0].blocked_mark_radius
         n = 0
-        for i, cm in self.maps.items():
-            n = max(n, mark_blocked(cm, xy, self.cfgs[i].blocked_mark_radius, self.cfgs[i]))
+        for _ in range(4):
+            for cm in self.maps.values():
+                n = max(n, mark_blocked(cm, xy, radius, self.cfgs[0]))
+            if n:
+                break
+            radius *= 2
         return n
 
 
@@ -220,7 +228,7 @@ def _follow(agent: StepAgent, waypoints: NDArray[np.float64], cfg: PlannerConfig
         else:
             ok = _drive_discrete(agent, wp, cfg, log)
         if not ok:
-            return _contact_point(agent, wp, cfg)
+            return _contact_point(agent, wp, cfg, log)
     return None
 
 
@@ -231,12 +239,34 @@ def _trajectory(agent: object) -> list[tuple[float, float]]:
     return [(float(p[0]), float(p[1])) for p in traj]
 
 
-def _contact_point(agent: StepAgent, target: NDArray[np.float64], cfg: PlannerConfig) -> NDArray[np.float64]:
-    """Where the unseen obstacle is: just beyond the agent's rim, towards where it was going."""
+def _contact_point(agent: StepAgent, target: NDArray[np.float64], cfg: PlannerConfig, log: _Log
+                   ) -> NDArray[np.float64]:
+    """Where the unseen obstacle is: just beyond the agent's rim, in the direction of contact.
+
+    The direction of travel is a poor guess when the agent grazed something at its side (it would
+    seal a corridor the agent can pass), so an agent with ``move_to`` feels around like a bumper:
+    tiny moves in 8 directions, each undone, and the blocked ones point at the obstacle.
+    """
     x, y, yaw = (float(v) for v in agent.pose)
     d = np.asarray(target, dtype=np.float64) - (x, y)
     n = float(np.hypot(*d))
     u = d / n if n > 1e-6 else np.array([math.cos(yaw), math.sin(yaw)])
+    move_to = getattr(agent, "move_to", None)
+    if move_to is not None and cfg.probe_step > 0:
+        blocked = []
+        for a in np.linspace(0.0, 2 * np.pi, 8, endpoint=False):
+            v = np.array([math.cos(a), math.sin(a)])
+            if move_to(x + cfg.probe_step * v[0], y + cfg.probe_step * v[1]):
+                move_to(x, y)
+            else:
+                blocked.append(v)
+                if math.hypot(agent.pose[0] - x, agent.pose[1] - y) > 1e-9:
+                    move_to(x, y)
+        log.record()
+        if blocked:
+            m = np.sum(blocked, axis=0)
+            if float(np.hypot(*m)) > 1e-6:
+                u = m / float(np.hypot(*m))
     return np.array([x, y]) + u * (cfg.robot_radius + cfg.blocked_mark_radius)
 
 
