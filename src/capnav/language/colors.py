@@ -140,11 +140,11 @@ class ColorCluster:
 
 @dataclass(frozen=True)
 class ColorConfig:
-    max_clusters: int = 3
+    max_clusters: int = 4
     max_points: int = 4000  # subsample for speed
     iterations: int = 12
     lit_percentile: float = 85.0  # shading only darkens: best-lit points approximate the albedo
-    min_fraction: float = 0.12  # clusters smaller than this are not reported
+    min_fraction: float = 0.08  # clusters smaller than this are not reported
     kL: float = 2.0
     luminance_weight: float = 0.04  # chromaticity units per e-fold of luminance
     merge_distance: float = 0.05  # k-means clusters closer than this are one surface (lit + shaded)

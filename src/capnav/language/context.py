@@ -1,10 +1,12 @@
 """What the map itself says about an object's surroundings: neighbours, relative size and the room.
 
-Room names are never observed, so a room is inferred from characteristic objects seen nearby
-(fridge / stove / counter -> kitchen, bed -> bedroom, toilet / bathtub -> bathroom, sofa / TV ->
-living room, desk -> office), weighted by distance and counted only when no wall lies between the
-two objects. Walls are occupied cells of the top-down grid that no object's box covers, so
-furniture standing between two objects does not hide them from each other.
+Room names are never observed, so a room is inferred from characteristic objects (fridge / stove /
+counter -> kitchen, bed -> bedroom, toilet / bathtub -> bathroom, sofa / TV -> living room,
+desk -> office). With an occupancy grid the map is segmented into rooms (``rooms.segment_rooms``)
+and each room's type is voted by the characteristic objects inside it; without one (or for an
+object outside every segmented room) the cues are weighted by distance and counted only when no
+wall lies between the two objects. Walls are occupied cells of the top-down grid that no
+object's box covers, so furniture standing between two objects does not hide them from each other.
 Used by the offline captioner ("next to the bed", "in the kitchen") and by retrieval predicates.
 """
 
@@ -79,7 +81,31 @@ class SceneContext:
         gap = np.maximum(0.0, np.maximum(self.lo[:, None] - self.hi[None], self.lo[None] - self.hi[:, None]))
         self.gap = np.hypot(gap[..., 0], gap[..., 1])
         self.visible = self._line_of_sight()
+        self.cue_distance = self._cue_distances()
         self.rooms = [self._room(i) for i in range(n)]
+
+    def _cue_distances(self) -> dict[int, NDArray[np.float64]]:
+        """Walking distance (m) from each room-cue object to every object (geodesic when a grid
+        is known: through free space and furniture, not through walls)."""
+        cue_ids = [k for k, lab in enumerate(self.labels) if any(lab in c for c in ROOM_CUES.values())]
+        out: dict[int, NDArray[np.float64]] = {}
+        if self.occupancy is None:
+            for k in cue_ids:
+                d = np.linalg.norm(self.xy - self.xy[k], axis=1)
+                out[k] = np.where(self.visible[k], d, np.inf)
+            return out
+        from capnav.language.rooms import box_min, geodesic_from_box, walkable_domain
+
+        spec = self.occupancy.spec
+        domain = walkable_domain(self.occupancy, self.lo, self.hi)
+        # The inner half of each box: a box's rim may poke through the wall it stands against.
+        q = 0.25 * (self.hi - self.lo)
+        ilo, ihi = self.lo + q, self.hi - q
+        for k in cue_ids:
+            field = geodesic_from_box(domain, spec, ilo[k], ihi[k], limit_m=4 * self.config.room_sigma)
+            out[k] = np.array([box_min(field, spec, ilo[j], ihi[j]) for j in range(len(self.objects))])
+            out[k][k] = 0.0
+        return out
 
     # -- walls ---------------------------------------------------------------------------------
     def _wall_mask(self) -> NDArray[np.bool_] | None:
@@ -119,14 +145,15 @@ class SceneContext:
 
     # -- rooms ---------------------------------------------------------------------------------
     def room_scores(self, i: int) -> dict[str, float]:
-        d = np.linalg.norm(self.xy - self.xy[i], axis=1)
-        w = np.exp(-0.5 * (d / self.config.room_sigma) ** 2) * self.visible[i]
+        """Per room type, the strongest cue: max over cue objects of weight * exp(-d^2 / 2 sigma^2)
+        with d the walking distance (the nearest stove says "kitchen"; ten armchairs do not add up)."""
         scores: dict[str, float] = {}
         for room, cues in ROOM_CUES.items():
             s = 0.0
-            for k, lab in enumerate(self.labels):
-                if lab in cues:
-                    s += cues[lab] * float(w[k])
+            for k, dist in self.cue_distance.items():
+                w = cues.get(self.labels[k], 0.0)
+                if w > 0.0 and np.isfinite(dist[i]):
+                    s = max(s, w * float(np.exp(-0.5 * (dist[i] / self.config.room_sigma) ** 2)))
             scores[room] = s
         return scores
 

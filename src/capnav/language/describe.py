@@ -2,7 +2,8 @@
 
 Captions are cached in ``cmap.caches["captions"]`` under the captioner's ``cache_key`` (a hash of
 the views' content, the prompt and the model), so a rerun is free and reproducible; the cache
-travels inside the map file, as the paper released its cached captions.
+travels inside the map file, as the paper released its cached captions. The measured colours go
+to ``cmap.caches["attributes"]`` so that verification does not recompute them per query.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from capnav.core.progress import track
 from capnav.language.captioner import Captioner
 from capnav.language.context import ContextConfig, SceneContext
 from capnav.language.embedder import TextEmbedder
+from capnav.language.offline_captioner import ObservationCaptioner
 from capnav.language.views import FrameReader, ViewConfig, select_views_all
 from capnav.mapping.cmap import CapNavMap
 
@@ -67,6 +69,11 @@ def describe_map(cmap: CapNavMap, reader: FrameReader | None, captioner: Caption
         else:
             # Fallbacks are not cached: the next run should try the model again.
             cache[key] = {"caption": cap.text, "source": cap.source, "object": obj.id}
+    attrs = cmap.caches.setdefault("attributes", {})
+    namer = ObservationCaptioner()
+    for obj in cmap.objects:
+        attrs[str(obj.id)] = {"colors": [[c.name, *[round(v, 3) for v in c.lab], round(c.fraction, 4),
+                                          round(c.distance, 3)] for c in namer.colors(obj)]}
     t2 = time.perf_counter()
     texts = [o.caption or "" for o in cmap.objects]
     if texts:

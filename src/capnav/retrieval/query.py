@@ -188,6 +188,8 @@ def parse_instruction(text: str) -> ParsedQuery:
             break
     q.size_word = next((_SIZE_WORDS[w] for w in words if w in _SIZE_WORDS), None)
     q.colors = _colors(words)
+    if len(q.colors) > 1 and "terracotta" in q.colors:  # "a yellow terracotta pot": a material here
+        q.colors.remove("terracotta")
     q.shapes = list(dict.fromkeys(_SHAPES[w] for w in words if w in _SHAPES))
     if "l-shaped" in head or "l shaped" in head:
         q.shapes = list(dict.fromkeys([*q.shapes, "L-shaped"]))

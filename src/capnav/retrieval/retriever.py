@@ -78,6 +78,7 @@ class Retriever:
         self.verifier = verifier if verifier is not None else OfflineVerifier()
         if isinstance(self.verifier, OfflineVerifier):
             self.verifier.bind(embedder, self.scene)
+            self.verifier.use_attributes(cmap.caches.get("attributes", {}))
         cache = cmap.caches.setdefault("verifications", {})
         if hasattr(self.verifier, "cache") and getattr(self.verifier, "cache", None) == {}:
             self.verifier.cache = cache

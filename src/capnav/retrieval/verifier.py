@@ -85,7 +85,7 @@ class AcceptFirst(Verifier):
 @dataclass(frozen=True)
 class OfflineVerifierConfig:
     name_threshold: float = 0.78  # cosine between target noun and caption name for a non-category match
-    color_min: float = 0.22  # exp(-ΔE/12): about ΔE00 <= 18
+    color_reject: float = 0.05  # exp(-ΔE/12) below this (ΔE00 > 36) the colour clearly disagrees
     w_rank: float = 0.5
     w_color: float = 1.0
     w_size: float = 0.6
@@ -106,6 +106,13 @@ class OfflineVerifier(Verifier):
     def bind(self, embedder: TextEmbedder, scene: SceneContext) -> None:
         self.embedder = self.embedder or embedder
         self.scene = scene
+
+    def use_attributes(self, attributes: dict[str, Any]) -> None:
+        """Colours measured by ``describe_map`` (``cmap.caches["attributes"]``), so queries need not
+        recompute them."""
+        for key, rec in attributes.items():
+            self._colors[int(key)] = [ColorCluster(str(n), (float(L), float(a), float(b)), float(f), float(d))
+                                      for n, L, a, b, f, d in rec.get("colors", [])]
 
     def colors(self, obj: MapObject) -> list[ColorCluster]:
         if obj.id not in self._colors:
@@ -157,7 +164,7 @@ class OfflineVerifier(Verifier):
                 rejects.append(why)
                 continue
             col, cwhy = self._color(query, c.obj)
-            if query.colors and col < cfg.color_min:
+            if query.colors and col < cfg.color_reject:
                 rejects.append(f"{why} but {cwhy}")
                 continue
             shape = 0.0
