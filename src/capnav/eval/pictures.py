@@ -22,7 +22,7 @@ def draw_failure(r: SubgoalRecord, assets: Any, cmap: Any, out_png: Path) -> Pat
     goal_xy = truth.footprints[nearest].mean(axis=0)
     title = (f"{r.method} / {r.protocol} / {r.episode_id} #{r.index}: \"{r.text}\" - "
              f"chose {'map object ' + str(r.chosen_object) if r.chosen_object is not None else 'no object'}; "
-             f"true {r.category} (instance {nearest}, X) is {r.distance_to_goal:.2f} m from the stop. {r.reason}")
+             f"true {r.category} (instance {nearest}, X) is {r.distance_to_goal:.2f} m from the stop. {r.reason[:160]}")
     traj = np.asarray(r.trajectory, dtype=np.float64).reshape(-1, 2)
     return draw_navigation(cmap.occupancy, cmap.objects, r.chosen_object, None, traj, r.start_xy, r.stop_xy,
                            title[:400], out_png, goal=(float(goal_xy[0]), float(goal_xy[1])), reach=1.0, dpi=80)

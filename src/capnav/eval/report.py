@@ -57,7 +57,7 @@ def table2(summaries: Sequence[Summary]) -> list[str]:
         if lab is None and des is None:
             continue
         cells = [_pct(s.in_a_row[-1] if s else None) + " | " + _pct(s.independent if s else None) for s in (lab, des)]
-        lines.append(f"| {name} ({label}) | {cells[0]} | {cells[1]} | {psr:g} | {psub:g} |")
+        lines.append(f"| {name} ({label}) | {cells[0]} | {cells[1]} | {psr:.1f} | {psub:.1f} |")
     return lines
 
 
