@@ -126,10 +126,12 @@ def save_map(cmap: CapNavMap, path: str | Path) -> Path:
 
     def writer(fh: IO[bytes]) -> None:
         with zipfile.ZipFile(fh, "w") as zf:
-            for name, data in blobs.items():
-                compress = zipfile.ZIP_DEFLATED if name.endswith(".json") else zipfile.ZIP_STORED
-                zf.writestr(name, data, compress_type=compress)
-            zf.writestr("header.json", _json(header, "header"), compress_type=zipfile.ZIP_DEFLATED)
+            for name, data in [*blobs.items(), ("header.json", _json(header, "header"))]:
+                # A fixed timestamp keeps the file bit-identical for identical maps.
+                info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
+                info.compress_type = zipfile.ZIP_DEFLATED if name.endswith(".json") else zipfile.ZIP_STORED
+                info.external_attr = 0o644 << 16
+                zf.writestr(info, data)
 
     out = Path(path)
     write_with(out, writer)

@@ -100,7 +100,7 @@ class VoxelMap:
         need = self._n + extra
         cap = self._keys.shape[0]
         if need > cap:
-            new = max(need, 2 * cap)
+            new = max(need, cap + cap // 2)
             keys = np.full(new, -1, dtype=np.int64)
             keys[: self._n] = self._keys[: self._n]
             w = np.zeros(new, dtype=np.float64)
