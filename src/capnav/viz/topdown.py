@@ -19,7 +19,7 @@ from capnav.core.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from capnav.mapping.objects import MapObject
 
 #: Grey levels of the occupancy image: free white, unknown light grey, occupied dark.
-OCC_RGB = {FREE: (1.0, 1.0, 1.0), UNKNOWN: (0.82, 0.82, 0.85), OCCUPIED: (0.25, 0.25, 0.28)}
+OCC_RGB = {FREE: (1.0, 1.0, 1.0), UNKNOWN: (0.82, 0.82, 0.85), OCCUPIED: (0.45, 0.45, 0.48)}
 CHOSEN = "#d62728"
 PATH = "#1f77b4"
 TRAJ = "#ff7f0e"
@@ -66,9 +66,9 @@ def draw_navigation(occ: OccupancyGrid, objects: Sequence[MapObject], chosen_id:
         if fp.ndim != 2 or len(fp) < 3:
             continue
         chosen = obj.id == chosen_id
-        ax.add_patch(Polygon(fp, closed=True, fill=True, alpha=0.35 if chosen else 0.18,
-                             facecolor=CHOSEN if chosen else "#2ca02c",
-                             edgecolor=CHOSEN if chosen else "#2c6e2c", linewidth=2.2 if chosen else 0.8))
+        ax.add_patch(Polygon(fp, closed=True, fill=True, alpha=0.6 if chosen else 0.5,
+                             facecolor=CHOSEN if chosen else "#7cc47f",
+                             edgecolor=CHOSEN if chosen else "#1b5e20", linewidth=2.2 if chosen else 0.8))
         cx, cy = fp.mean(axis=0)
         ax.text(cx, cy, short_label(obj), fontsize=7.5 if chosen else 5.5, ha="center", va="center",
                 color=CHOSEN if chosen else "#1b3d1b", fontweight="bold" if chosen else "normal",
@@ -77,11 +77,11 @@ def draw_navigation(occ: OccupancyGrid, objects: Sequence[MapObject], chosen_id:
             _draw_reach(ax, fp, reach)
     if path_xy is not None and len(path_xy):
         p = np.asarray(path_xy, dtype=np.float64)
-        ax.plot(p[:, 0], p[:, 1], "--", color=PATH, lw=1.6, label="planned path", zorder=4)
-        ax.plot(p[:, 0], p[:, 1], ".", color=PATH, ms=5, zorder=4)
+        ax.plot(p[:, 0], p[:, 1], "--", color=PATH, lw=1.4, label="planned path", zorder=6)
+        ax.plot(p[:, 0], p[:, 1], ".", color=PATH, ms=4, zorder=6)
     if trajectory_xy is not None and len(trajectory_xy):
         t = np.asarray(trajectory_xy, dtype=np.float64)
-        ax.plot(t[:, 0], t[:, 1], "-", color=TRAJ, lw=2.0, alpha=0.9, label="executed", zorder=5)
+        ax.plot(t[:, 0], t[:, 1], "-", color=TRAJ, lw=2.6, alpha=0.9, label="executed", zorder=5)
     _mark(ax, start, "o", "#2ca02c", "start")
     _mark(ax, goal, "X", PATH, "goal")
     _mark(ax, end, "s", CHOSEN, "end")
@@ -104,10 +104,10 @@ def _mark(ax: Any, pose: Pose | None, marker: str, color: str, label: str) -> No
     if pose is None:
         return
     p = [float(v) for v in pose]
-    ax.plot(p[0], p[1], marker, color=color, ms=9, mec="black", mew=0.8, label=label, zorder=6)
+    ax.plot(p[0], p[1], marker, color=color, ms=9, mec="black", mew=0.8, label=label, zorder=7)
     if len(p) >= 3:
         ax.annotate("", xy=(p[0] + 0.45 * np.cos(p[2]), p[1] + 0.45 * np.sin(p[2])), xytext=(p[0], p[1]),
-                    arrowprops={"arrowstyle": "->", "color": color, "lw": 1.5}, zorder=6)
+                    arrowprops={"arrowstyle": "->", "color": color, "lw": 1.5}, zorder=7)
 
 
 def _draw_reach(ax: Any, fp: NDArray[np.float64], reach: float) -> None:

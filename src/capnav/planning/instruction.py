@@ -1,0 +1,103 @@
+"""One instruction end to end: retrieve the described object, plan to it, drive there, draw it.
+
+The pipeline sees the map only; the simulator is the world the agent drives in (its obstacles
+are read only when the caller asks to plan on the true occupancy, for comparison).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from capnav.core.errors import InputError
+from capnav.core.grid import OccupancyGrid
+from capnav.planning.config import PlannerConfig
+from capnav.planning.execute import NavResult, navigate_to
+
+if TYPE_CHECKING:
+    from capnav.mapping.cmap import CapNavMap
+    from capnav.retrieval.result import QueryResult
+    from capnav.retrieval.retriever import Retriever
+    from capnav.sim.simulator import Simulator
+
+OCCUPANCY_KINDS = ("mapped", "truth")
+
+
+@dataclass
+class InstructionOutcome:
+    instruction: str
+    query: QueryResult
+    nav: NavResult | None
+    start: tuple[float, float, float]
+    occupancy: str
+    png: Path | None = None
+    json: Path | None = None
+
+    @property
+    def reached(self) -> bool:
+        return self.nav is not None and self.nav.reached
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"instruction": self.instruction, "occupancy": self.occupancy,
+                "start": [round(v, 4) for v in self.start], "retrieval": self.query.to_dict(),
+                "navigation": None if self.nav is None else self.nav.to_dict()}
+
+
+def parse_pose(text: str) -> tuple[float, float, float]:
+    """``"X,Y"`` or ``"X,Y,YAW"`` (metres, radians) -> (x, y, yaw)."""
+    try:
+        vals = [float(v) for v in text.replace(" ", "").split(",")]
+    except ValueError:
+        raise InputError(f"start must be X,Y or X,Y,YAW numbers, got {text!r}") from None
+    if len(vals) not in (2, 3) or not np.isfinite(vals).all():
+        raise InputError(f"start must be X,Y or X,Y,YAW finite numbers, got {text!r}")
+    return vals[0], vals[1], vals[2] if len(vals) == 3 else 0.0
+
+
+def random_start(sim: Simulator, seed: int) -> tuple[float, float, float]:
+    """A seeded navigable start pose (when no episode or ``--start`` gives one)."""
+    rng = np.random.default_rng([seed, 5])
+    x, y = sim.random_navigable_point(rng)
+    return x, y, float(rng.uniform(-np.pi, np.pi))
+
+
+def planning_occupancy(cmap: CapNavMap, sim: Simulator, kind: str) -> OccupancyGrid:
+    if kind == "mapped":
+        return cmap.occupancy
+    if kind == "truth":
+        return sim.obstacles(resolution=cmap.occupancy.spec.resolution)
+    raise InputError(f"occupancy must be one of {', '.join(OCCUPANCY_KINDS)}, got {kind!r}")
+
+
+def run_instruction(cmap: CapNavMap, sim: Simulator, retriever: Retriever, instruction: str,
+                    start: tuple[float, float, float], occupancy: str = "mapped",
+                    config: PlannerConfig | None = None, out_dir: str | Path | None = None,
+                    stem: str = "navigate") -> InstructionOutcome:
+    """Retrieve, plan, execute; with ``out_dir`` write ``<stem>.png`` and ``<stem>.json``."""
+    cfg = config or PlannerConfig()
+    occ = planning_occupancy(cmap, sim, occupancy)
+    agent = sim.spawn_agent(*start)
+    query = retriever.query(instruction, robot_xy=(start[0], start[1]))
+    nav = None
+    if query.found and query.chosen is not None:
+        nav = navigate_to(agent, occ, query.chosen.footprint, cfg)
+    out = InstructionOutcome(instruction, query, nav, start, occupancy)
+    if out_dir is not None:
+        from capnav.viz.topdown import short_label, write_navigation
+
+        chosen = query.chosen
+        if nav is None:
+            title = f'"{instruction}": no object chosen ({query.reason})'
+        else:
+            title = (f'"{instruction}" -> {short_label(chosen) if chosen else "?"}: '
+                     f"{'reached' if nav.reached else 'NOT reached'}, {nav.distance_to_object:.2f} m from it, "
+                     f"path {nav.path_length:.1f} m, {nav.replans} replans")
+        out.png, out.json = write_navigation(
+            out_dir, stem, occ, cmap.objects, chosen.id if chosen else None,
+            None if nav is None else nav.waypoints, None if nav is None else nav.trajectory, start,
+            agent.pose, title, goal=None if nav is None or nav.goal is None else (*nav.goal.xy, nav.goal.yaw),
+            reach=cfg.reach, **{k: v for k, v in out.to_dict().items() if k != "start"})
+    return out
