@@ -75,6 +75,10 @@ class Instruction:
     robot_xy: tuple[float, float] | None = None
     details: dict[str, Any] = field(default_factory=dict)
 
+    @property
+    def target_ids(self) -> list[int]:
+        return self.targets
+
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
 
@@ -305,8 +309,10 @@ class InstructionGenerator:
 
 
 def generate_instructions(manifest: SceneManifest, per_kind: int = 10, seed: int = 0,
-                          kinds: Sequence[str] = KINDS, config: InstructionConfig | None = None) -> list[Instruction]:
-    """Up to ``per_kind`` instructions of each kind (fewer when the scene allows fewer), seeded."""
+                          kinds: Sequence[str] = KINDS, config: InstructionConfig | None = None,
+                          robot_xy: tuple[float, float] | None = None) -> list[Instruction]:
+    """Up to ``per_kind`` instructions of each kind (fewer when the scene allows fewer), seeded.
+    "closest" instructions use ``robot_xy`` when given, else random free positions in rooms."""
     for k in kinds:
         if k not in KINDS:
             raise InputError(f"unknown instruction kind {k!r}; kinds: {', '.join(KINDS)}")
@@ -327,7 +333,7 @@ def generate_instructions(manifest: SceneManifest, per_kind: int = 10, seed: int
             tries = 0
             while len(made) < per_kind and tries < 50 * per_kind:
                 tries += 1
-                xy = gen.robot_position(rng)
+                xy = robot_xy if robot_xy is not None else gen.robot_position(rng)
                 cands = [o for o in objs if gen.closest_ok(o, xy)]
                 if cands:
                     ins = gen.describe_as(cands[int(rng.integers(len(cands)))], "closest", rng, xy)

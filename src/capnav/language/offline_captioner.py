@@ -41,7 +41,8 @@ class OfflineCaptionConfig:
     second_color_fraction: float = 0.25  # report a second colour when it covers this share
     min_points: int = 30  # fewer fused points than this: use the views' pixels for colour
     round_circularity: float = 0.86  # 4*pi*A/P^2 of the footprint hull (square: 0.785)
-    l_shape_fill: float = 0.72  # occupied share of the footprint hull below which it is L-shaped
+    l_shape_fill: float = 0.86  # occupied share of the footprint hull below which it is L-shaped
+    l_shape_min_area: float = 1.5  # m² of hull: only sofa/counter-sized objects can be L-shaped
     long_aspect: float = 2.3
 
 
@@ -81,13 +82,21 @@ def footprint_shape(obj: MapObject, cfg: OfflineCaptionConfig) -> str | None:
     area, perim = float(hull.volume), float(hull.area)
     if area < 0.02:
         return None
+    # Occupied share of the hull, both counted on the same grid (cells whose centre is inside).
+    from scipy.spatial import Delaunay
+
     res = max(0.04, np.sqrt(area / 400.0))
-    cells = np.unique(np.floor(xy / res).astype(np.int64), axis=0)
-    occ = len(cells) * res * res / area
+    origin = xy.min(0)
+    cells = np.unique(np.floor((xy - origin) / res).astype(np.int64), axis=0)
+    span = np.floor((xy.max(0) - origin) / res).astype(np.int64) + 1
+    gx, gy = np.meshgrid(np.arange(span[0]), np.arange(span[1]), indexing="ij")
+    centres = origin + (np.stack([gx.ravel(), gy.ravel()], 1) + 0.5) * res
+    in_hull = int((Delaunay(xy[hull.vertices]).find_simplex(centres) >= 0).sum())
+    occ = len(cells) / max(in_hull, 1)
     centered = xy - xy.mean(0)
     ev = np.linalg.eigvalsh(np.cov(centered.T))
     aspect = float(np.sqrt(max(ev[1], 1e-9) / max(ev[0], 1e-9)))
-    if occ < cfg.l_shape_fill and aspect < 2.0:
+    if occ < cfg.l_shape_fill and aspect < 2.0 and area >= cfg.l_shape_min_area:
         return "L-shaped"
     if 4 * np.pi * area / perim**2 >= cfg.round_circularity and aspect < 1.25:
         return "round"

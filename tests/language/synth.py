@@ -1,0 +1,103 @@
+"""Synthetic map objects and frames for language/retrieval tests (no simulator, no manifest)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from capnav.core.frame import Frame
+from capnav.core.geometry import Intrinsics, look_at_pose
+from capnav.core.grid import FREE, OCCUPIED, GridSpec, OccupancyGrid
+from capnav.mapping.cmap import CapNavMap
+from capnav.mapping.objects import MapObject, Observation
+from capnav.mapping.voxel_map import VoxelMap
+
+
+def make_obj(oid: int, label: str, center: tuple[float, float], size: tuple[float, float, float],
+             rgb: tuple[int, int, int], seed: int = 0, n: int = 600, second: tuple[int, int, int] | None = None,
+             shading: tuple[float, float] = (0.6, 1.0)) -> MapObject:
+    """A box-shaped object with shaded surface points of colour ``rgb`` (20% ``second`` if given)."""
+    rng = np.random.default_rng(seed + oid)
+    c = np.array([center[0], center[1], size[2] / 2])
+    half = np.array(size) / 2
+    pts = c + rng.uniform(-1, 1, (n, 3)) * half
+    base = np.tile(np.array(rgb, dtype=np.float64), (n, 1))
+    if second is not None:
+        base[: n // 5] = second
+    lin = (base / 255.0) ** 2.2 * rng.uniform(*shading, (n, 1))
+    cols = np.clip(255 * lin ** (1 / 2.2), 0, 255).astype(np.uint8)
+    lo, hi = c - half, c + half
+    fp = np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])
+    return MapObject(id=oid, label=label, label_votes={label: 5.0}, position=c, extent_min=lo, extent_max=hi,
+                     footprint=fp, points=pts.astype(np.float32), colors=cols, feature=np.zeros(4, np.float32),
+                     hits=5)
+
+
+def grid_with_wall(xmin: float, ymin: float, xmax: float, ymax: float, wall_x: float | None = None,
+                   door: tuple[float, float] | None = None) -> OccupancyGrid:
+    """A FREE rectangle with outer walls and optionally a wall at x = ``wall_x`` with a door (y range)."""
+    spec = GridSpec.covering(xmin, ymin, xmax, ymax, 0.05, margin=0.2)
+    cells = np.full((spec.rows, spec.cols), FREE, dtype=np.uint8)
+    cells[:3, :], cells[-3:, :], cells[:, :3], cells[:, -3:] = OCCUPIED, OCCUPIED, OCCUPIED, OCCUPIED
+    if wall_x is not None:
+        col = int(spec.to_cell(np.array([wall_x, 0.0]))[1])
+        cells[:, col - 1:col + 2] = OCCUPIED
+        if door is not None:
+            r0 = int(spec.to_cell(np.array([0.0, door[0]]))[0])
+            r1 = int(spec.to_cell(np.array([0.0, door[1]]))[0])
+            cells[r0:r1, col - 1:col + 2] = FREE
+    return OccupancyGrid(spec, cells)
+
+
+def make_map(objects: list[MapObject], occupancy: OccupancyGrid | None = None) -> CapNavMap:
+    if occupancy is None:
+        occupancy = grid_with_wall(-1, -1, 9, 7)
+    return CapNavMap(objects=objects, voxels=VoxelMap(), occupancy=occupancy)
+
+
+def living_scene() -> list[MapObject]:
+    """Two sofas (red large, grey small), a bed, two chairs, a stove, a lamp."""
+    return [
+        make_obj(1, "sofa", (1.0, 1.0), (2.2, 0.9, 0.8), (178, 34, 34)),
+        make_obj(2, "sofa", (5.0, 1.0), (1.6, 0.8, 0.8), (128, 128, 128)),
+        make_obj(3, "bed", (7.0, 5.0), (1.6, 2.0, 0.5), (40, 70, 170)),
+        make_obj(4, "chair", (7.0, 3.6), (0.5, 0.5, 0.9), (180, 140, 90)),
+        make_obj(5, "chair", (1.0, 5.0), (0.5, 0.5, 0.9), (180, 140, 90)),
+        make_obj(6, "stove", (1.0, 6.2), (0.6, 0.6, 0.9), (190, 192, 196)),
+        make_obj(7, "lamp", (3.0, 3.0), (0.4, 0.4, 1.6), (225, 190, 40)),
+    ]
+
+
+class SquareReader:
+    """Frames of a coloured square on grey, viewed from several places (a FrameReader)."""
+
+    def __init__(self, n: int = 8, width: int = 160, height: int = 120) -> None:
+        self.K = Intrinsics.from_fov(width, height, 60.0)
+        self.n = n
+
+    def __len__(self) -> int:
+        return self.n
+
+    def frame(self, index: int) -> Frame:
+        h, w = self.K.height, self.K.width
+        rgb = np.full((h, w, 3), 120, dtype=np.uint8)
+        x0, y0, x1, y1 = self.box(index)
+        yy, xx = np.mgrid[0:h, 0:w]
+        checker = ((xx // 4 + yy // 4) % 2).astype(np.uint8) * 60
+        sl = (slice(int(y0), int(y1)), slice(int(x0), int(x1)))
+        rgb[sl] = np.stack([200 + checker[sl] // 2, 30 + checker[sl] // 3, 30 + 0 * checker[sl]], axis=-1)
+        yaw = 2 * np.pi * index / self.n
+        eye = np.array([3 * np.cos(yaw), 3 * np.sin(yaw), 1.0])
+        return Frame(index, rgb, np.full((h, w), 2.0, np.float32), self.K, look_at_pose(eye, yaw + np.pi, 0.2))
+
+    def box(self, index: int) -> tuple[float, float, float, float]:
+        s = 10 + 6 * index  # grows with the index
+        cx = 20 + 15 * index
+        return (float(max(cx - s, 0)), float(60 - s // 2), float(min(cx + s, 159)), float(60 + s // 2))
+
+    def observations(self) -> list[Observation]:
+        out = []
+        for i in range(self.n):
+            b = self.box(i)
+            out.append(Observation(i, b, int((b[2] - b[0]) * (b[3] - b[1])), 0.9, "sofa", 2.0,
+                                   truncated=b[0] <= 0 or b[2] >= 159, visibility=1.0))
+        return out
