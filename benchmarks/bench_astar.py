@@ -96,13 +96,15 @@ def main() -> None:
     backends["numba"](warm, (0, 0), (7, 7))
     print(f"# numba A* first call (load or compile): {time.perf_counter() - t0:.2f} s, not counted below")
     cfg = PlannerConfig()
-    print(f"# median ms per query; apartments: sim.obstacles(0.05) inflated by {cfg.inflation:.2f} m; pairs seed "
-          f"{args.seed}")
+    flat = PlannerConfig(clearance_cost=0.0)
+    print(f"# median ms per query; apartments: sim.obstacles(0.05) inflated by {cfg.inflation:.2f} m, with the "
+          f"clearance cost (weights 1..{1 + cfg.clearance_cost:g}) and without it (uniform); pairs seed {args.seed}")
     print("| map                    | cells     |   n | " + " | ".join(f"{b:>8}" for b in backends) + " | costs |")
     print("|---|---|---:|" + "---:|" * len(backends) + "---|")
     for seed in args.seeds:
-        w = apartment_weights(seed, cfg)
-        print(run(f"apartment seed {seed}", w, pairs(w, args.queries, args.seed), backends), flush=True)
+        for tag, c in (("", cfg), (" uniform", flat)):
+            w = apartment_weights(seed, c)
+            print(run(f"apartment {seed}{tag}", w, pairs(w, args.queries, args.seed), backends), flush=True)
     w = random_weights(args.seed)
     print(run("random 800x800, 25%", w, pairs(w, max(args.queries // 4, 3), args.seed), backends), flush=True)
 

@@ -120,11 +120,11 @@ def main() -> None:
     print("| seed | occupancy | reachable / instances | trials | success % | replans | contacts* | ms / nav |")
     print("|---:|---|---:|---:|---:|---:|---:|---:|")
     print("\n".join(rows))
-    print("(*) agent contacts, including the bumper probes after each collision")
     for kind, (ok, n) in totals.items():
         rate = ok / max(n, 1)
         print(f"| all | {kind} | | {n} | {100.0 * rate:.1f} (target {100 * TARGET[kind]:.0f}"
               f"{', met' if rate >= TARGET[kind] else ', NOT met'}) | | | |")
+    print("(*) agent contacts, including the bumper probes after each collision")
 
 
 if __name__ == "__main__":
