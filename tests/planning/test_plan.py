@@ -165,3 +165,20 @@ def test_clearance_cost_centres_the_path_in_a_corridor() -> None:
     assert abs(np.median(ys_mid[inside]) - 2.5) < 0.1  # the corridor's centre line
     assert abs(np.median(ys_hug[len(ys_hug) // 3: 2 * len(ys_hug) // 3]) - 2.5) > 0.1
     plan_path(occ, start, goal)
+
+
+@pytest.mark.parametrize("backend", ["numba", "mcp", "pyastar2d"])
+def test_backends_plan_valid_paths(backend: str) -> None:
+    if backend == "mcp":
+        pytest.importorskip("skimage")
+    if backend == "pyastar2d":
+        pytest.importorskip("pyastar2d")
+    occ = wall_with_gap(1.0)
+    cfg = PlannerConfig(backend=backend)
+    path = plan_path(occ, (1.0, 1.0), (5.0, 4.0), cfg)
+    ours = plan_path(occ, (1.0, 1.0), (5.0, 4.0), PlannerConfig())
+    assert clearance(occ, densify(path.waypoints)).min() >= cfg.inflation - RES / 2 - 1e-9
+    if backend == "pyastar2d":  # optimal for its own metric only: never cheaper under ours
+        assert path.cost >= ours.cost - 1e-9
+    else:
+        assert path.cost == pytest.approx(ours.cost, rel=1e-9)
