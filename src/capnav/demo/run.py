@@ -63,19 +63,17 @@ def _png(obj: MapObject) -> bytes | None:
     return None
 
 
-def _instructions(cfg: DemoConfig, sim: Any, start_xy: tuple[float, float]) -> list[tuple[str, str, list[int]]]:
-    """(text, kind, target instance ids) for the demo: the user's, or one generated per kind."""
+def _next_instruction(cfg: DemoConfig, k: int, sim: Any, robot_xy: tuple[float, float]
+                      ) -> tuple[str, str, list[int]] | None:
+    """The k-th instruction (text, kind, target ids): the user's, or one generated for the k-th kind
+    from where the robot stands now (so that "closest" means closest to the robot when it is asked)."""
     if cfg.instructions:
-        return [(t, "user", []) for t in cfg.instructions]
+        return (cfg.instructions[k], "user", [])
     from capnav.eval.instructions import generate_instructions
 
-    rng = np.random.default_rng(cfg.seed)
-    out: list[tuple[str, str, list[int]]] = []
-    for kind in cfg.kinds:
-        cands = generate_instructions(sim.manifest, seed=int(rng.integers(1 << 31)), kinds=(kind,),
-                                      robot_xy=start_xy, per_kind=1)
-        out.extend((c.text, c.kind, list(c.target_ids)) for c in cands[:1])
-    return out
+    made = generate_instructions(sim.manifest, per_kind=1, seed=cfg.seed * 1000 + k, kinds=(cfg.kinds[k],),
+                                 robot_xy=robot_xy)
+    return (made[0].text, made[0].kind, list(made[0].targets)) if made else None
 
 
 def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
@@ -107,17 +105,23 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
     rng = np.random.default_rng(cfg.seed + 1)
     start = assets.truth.sample_start(rng)
     agent = sim.spawn_agent(start.x, start.y, start.yaw)
-    instructions = _instructions(cfg, sim, (start.x, start.y))
+    n = len(cfg.instructions) or len(cfg.kinds)
 
-    con.print(f"[bold]3/4[/] answering {len(instructions)} instructions and navigating")
+    con.print(f"[bold]3/4[/] answering {n} instructions and navigating")
     items: list[ReportItem] = []
     pcfg_plan = PlannerConfig()
-    for k, (text, kind, targets) in enumerate(instructions, 1):
-        items.append(_answer(k, text, kind, targets, retriever, agent, cmap, assets, pcfg_plan, out))
-        it = items[-1]
-        con.print(f"     {k}. {text!r}: {it.chosen_label or 'not found'} -> "
-                  f"{'reached' if it.reached else 'not reached' if it.found else '-'}"
-                  + ("" if it.correct is None else f", {'right' if it.correct else 'wrong'}"))
+    for k in range(n):
+        x, y, _ = agent.pose
+        nxt = _next_instruction(cfg, k, sim, (float(x), float(y)))
+        if nxt is None:
+            con.print(f"     (this apartment allows no {cfg.kinds[k]!r} instruction; skipped)")
+            continue
+        text, kind, targets = nxt
+        it = _answer(len(items) + 1, text, kind, targets, retriever, agent, cmap, assets, pcfg_plan, out)
+        items.append(it)
+        con.print(f"     {len(items)}. \\[{kind}] {text!r}: {it.chosen_label or 'not found'}"
+                  + (f" -> {'reached' if it.reached else 'not reached'}" if it.found else "")
+                  + ("" if it.correct is None else f" ({'right' if it.correct else 'wrong'})"))
 
     con.print("[bold]4/4[/] writing the report")
     timings["total"] = time.perf_counter() - t0
