@@ -27,7 +27,7 @@ def test_select_views_best_first_diverse_and_rendered():
     v = views[0]
     full, crop = _img(v.frame_png), _img(v.crop_png)
     assert full.shape == (120, 160, 3)
-    x0, y0, x1, y1 = (int(round(c)) for c in v.box)
+    x0, y0, x1, y1 = (round(c) for c in v.box)
     assert tuple(full[y0, (x0 + x1) // 2]) == (255, 0, 0)  # the box is drawn in red
     assert crop.shape[0] <= (y1 - y0) * 1.3 + 6 and crop.shape[1] <= (x1 - x0) * 1.3 + 6
     assert select_views(obj, reader, ViewConfig(max_views=2)).__len__() == 2
