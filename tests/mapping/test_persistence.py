@@ -68,3 +68,47 @@ def test_false_positives_and_short_tracks_never_become_objects(embedder) -> None
         m.integrate(f)
     assert m.tracker._next_id > 20  # plenty of false detections ...
     assert m.finish().objects == []  # ... none of them confirmed (random labels and places)
+
+
+def _det(points: np.ndarray, label: str = "chair", cls: int = 3):  # type: ignore[no-untyped-def]
+    from capnav.mapping import LiftedDetection
+    from capnav.perception import Detection
+
+    d = Detection((0, 0, 10, 10), cls, label, 0.9, np.zeros((4, 4), bool))
+    feat = np.array([1.0, 0.0] if label == "chair" else [0.0, 1.0], np.float32)  # label embeddings differ
+    return LiftedDetection(0, d, points.mean(axis=0), feat, points.astype(np.float32),
+                           np.full((len(points), 3), 100, np.uint8), 2.0, 1.0, False)
+
+
+def _feed(mem, track_id: int, pts: np.ndarray, frames: range, label: str = "chair", busy=()) -> int:  # type: ignore[no-untyped-def]
+    from capnav.mapping import Observation, Track
+
+    t = Track(track_id, pts.mean(0), np.zeros(3), np.zeros(4), np.array([1.0, 0.0], np.float32), 3, label)
+    oid = None
+    for k, f in enumerate(frames):
+        t.hits = k + 1
+        obs = Observation(f, (0, 0, 10, 10), 100, 0.9, label, 2.0, False, 1.0)
+        oid = mem.observe(t, _det(pts, label), obs, f, h_min=2, busy=set(busy))
+    assert oid is not None
+    return oid
+
+
+def test_merge_duplicates_unit() -> None:
+    from capnav.mapping import ObjectMemory
+
+    rng = np.random.default_rng(0)
+    cube = rng.uniform(0, 0.5, (300, 3))
+    mem = ObjectMemory()
+    a = _feed(mem, 1, cube, range(0, 3))
+    b = _feed(mem, 2, cube + 0.01, range(10, 13), busy=[a])  # forced apart: seen "with" a
+    c = _feed(mem, 3, cube + np.array([3.0, 0, 0]), range(20, 23))  # far away: distinct
+    d = _feed(mem, 4, cube, range(30, 33), label="bed", busy=[a, b])  # same place, incompatible label
+    e = _feed(mem, 5, cube, range(0, 3), busy=[a, b, d])  # co-visible with a in 3 frames: distinct
+    assert len({a, b, c, d, e}) == 5
+    assert mem.merge_duplicates() == 1
+    assert sorted(mem.objects) == sorted({a, c, d, e}) or sorted(mem.objects) == sorted({b, c, d, e})
+    kept = mem.objects[a] if a in mem.objects else mem.objects[b]
+    assert kept.hits == 6 and sorted(kept.track_ids) == [1, 2]
+    objs = mem.export()
+    assert [o.id for o in objs] == [1, 2, 3, 4]  # renumbered densely
+    assert sum(o.label == "bed" for o in objs) == 1

@@ -188,34 +188,52 @@ class ObjectMemory:
 
     # ---- end of mapping -----------------------------------------------------------------
     def merge_duplicates(self) -> int:
-        """Merge objects that overlap in 3D with compatible labels; returns how many were merged."""
-        cfg = self.config
-        ids = sorted(self.objects)
+        """Merge objects that overlap in 3D with compatible labels, best pair first; returns how
+        many were merged. Only pairs whose boxes (grown by ``overlap_radius``) intersect are scored,
+        and after a merge only the pairs of the grown object are re-scored."""
+        r = self.config.overlap_radius
+        bounds = {k: (o.points.min(axis=0) - r, o.points.max(axis=0) + r)
+                  for k, o in self.objects.items() if len(o.points)}
+        scores: dict[tuple[int, int], float] = {}
+
+        def score(a: int, b: int) -> None:
+            scores.pop((a, b), None)
+            if a not in bounds or b not in bounds:
+                return
+            (la, ha), (lb, hb) = bounds[a], bounds[b]
+            if np.any(la > hb) or np.any(lb > ha):
+                return
+            s = self._pair_score(self.objects[a], self.objects[b])
+            if s > 0:
+                scores[(a, b)] = s
+
+        ids = sorted(bounds)
+        for i, a in enumerate(ids):
+            for b in ids[i + 1:]:
+                score(a, b)
         merged = 0
-        changed = True
-        while changed:
-            changed = False
-            ids = sorted(self.objects)
-            best: tuple[float, int, int] | None = None
-            for a_i, a in enumerate(ids):
-                oa = self.objects[a]
-                for b in ids[a_i + 1:]:
-                    ob = self.objects[b]
-                    if len(oa.points) == 0 or len(ob.points) == 0:
-                        continue
-                    if len(oa.frames & ob.frames) > cfg.max_covisible:
-                        continue
-                    if not (labels_compatible(oa.label, ob.label) or self._cos(oa, ob) >= cfg.min_cos):
-                        continue
-                    small, big = (oa, ob) if len(oa.points) <= len(ob.points) else (ob, oa)
-                    s = self._overlap(small.points, big.points)
-                    if s > 0 and (best is None or s > best[0]):
-                        best = (s, big.id, small.id)
-            if best is not None:
-                self._absorb(self.objects[best[1]], self.objects.pop(best[2]))
-                merged += 1
-                changed = True
+        while scores:
+            (a, b), _ = max(scores.items(), key=lambda kv: (kv[1], -kv[0][0], -kv[0][1]))
+            keep, gone = (a, b) if len(self.objects[a].points) >= len(self.objects[b].points) else (b, a)
+            self._absorb(self.objects[keep], self.objects.pop(gone))
+            bounds.pop(gone)
+            pts = self.objects[keep].points
+            bounds[keep] = (pts.min(axis=0) - r, pts.max(axis=0) + r)
+            scores = {k: v for k, v in scores.items() if gone not in k and keep not in k}
+            for other in sorted(bounds):
+                if other != keep:
+                    score(min(keep, other), max(keep, other))
+            merged += 1
         return merged
+
+    def _pair_score(self, oa: _ObjectState, ob: _ObjectState) -> float:
+        cfg = self.config
+        if len(oa.frames & ob.frames) > cfg.max_covisible:
+            return 0.0
+        if not (labels_compatible(oa.label, ob.label) or self._cos(oa, ob) >= cfg.min_cos):
+            return 0.0
+        small, big = (oa, ob) if len(oa.points) <= len(ob.points) else (ob, oa)
+        return self._overlap(small.points, big.points)
 
     @staticmethod
     def _cos(a: _ObjectState, b: _ObjectState) -> float:
