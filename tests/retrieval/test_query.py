@@ -1,0 +1,48 @@
+from __future__ import annotations
+
+import pytest
+
+from capnav.core.errors import InputError
+from capnav.retrieval import parse_instruction, validate_instruction
+
+
+@pytest.mark.parametrize(("text", "expect"), [
+    ("go to the white sofa with curved edges", {"category": "sofa", "colors": ["white"], "shapes": ["curved"]}),
+    ("Please take me to the biggest couch", {"category": "sofa", "superlative": "largest"}),
+    ("closest chair", {"category": "chair", "proximity": "closest"}),
+    ("the nearest fridge to me", {"category": "refrigerator", "proximity": "closest"}),
+    ("the chair next to the bed", {"category": "chair", "relation": "next to", "anchor_category": "bed"}),
+    ("In the kitchen, find the stool.", {"category": "stool", "room": "kitchen"}),
+    ("the light blue bedside table", {"category": "nightstand", "colors": ["light blue"]}),
+    ("take me to the chiar", {"category": "chair"}),  # a typo
+    ("the plant in the yellow terracotta pot", {"category": "plant", "colors": ["yellow"]}),
+    ("the gray armchair beside the lamp in the study",
+     {"category": "armchair", "colors": ["grey"], "relation": "next to", "anchor_category": "lamp",
+      "room": "office"}),
+])
+def test_parse(text, expect):
+    q = parse_instruction(text).to_dict()
+    for k, v in expect.items():
+        assert q[k] == v, (k, q)
+
+
+def test_unknown_target_and_category_only():
+    q = parse_instruction("find the piano")
+    assert q.category is None and q.unknown_words == ["piano"] and q.target_phrase == "piano"
+    assert parse_instruction("the sofa").category_only
+    assert not parse_instruction("the red sofa").category_only
+
+
+@pytest.mark.parametrize(("text", "msg"), [
+    ("", "empty"), ("   ", "empty"), ("sofa " * 80, "too long"), ("a" * 400, "too long"),
+    ("去白色的沙发", "English"), ("Geh bitte zum weißen Sofa und dann zur Küche", "English"),
+    ("ve al sofá blanco por favor", "English"), ("1234 !!", "no words"),
+])
+def test_bad_instructions(text, msg):
+    with pytest.raises(InputError, match=msg):
+        validate_instruction(text)
+
+
+def test_non_string():
+    with pytest.raises(InputError):
+        validate_instruction(None)
