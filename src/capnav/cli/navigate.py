@@ -35,10 +35,13 @@ def register(app: typer.Typer) -> None:
         from capnav.core.errors import InputError
         from capnav.io.mapfile import load_map
         from capnav.language import create_embedder
-        from capnav.planning.instruction import parse_pose, random_start, run_instruction
+        from capnav.planning.instruction import OCCUPANCY_KINDS, parse_pose, random_start, run_instruction
         from capnav.retrieval import Retriever, create_verifier
         from capnav.sim import Simulator
 
+        if occupancy not in OCCUPANCY_KINDS:  # fail before the slow loading below
+            raise InputError(f"occupancy must be one of {', '.join(OCCUPANCY_KINDS)}, got {occupancy!r}")
+        given = parse_pose(start) if start else None
         cmap = load_map(map_file)
         scene_seed = scene if scene is not None else cmap.meta.get("scene_seed")
         if scene_seed is None:
@@ -47,7 +50,7 @@ def register(app: typer.Typer) -> None:
         ver_kw = {"embedder": emb} if verifier == "offline" else {}
         retriever = Retriever(cmap, emb, create_verifier(verifier, **ver_kw))
         with Simulator.from_seed(int(scene_seed)) as sim:
-            pose = parse_pose(start) if start else random_start(sim, seed)
+            pose = given or random_start(sim, seed)
             res = run_instruction(cmap, sim, retriever, instruction, pose, occupancy, out_dir=out)
         con = Console(stderr=True)
         q, nav = res.query, res.nav
