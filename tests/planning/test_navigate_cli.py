@@ -13,6 +13,7 @@ from capnav.core.errors import InputError
 from capnav.eval.success import footprint_distance
 
 SCENE = 2
+pytestmark = pytest.mark.slow  # explores, maps and captions a (small) apartment first
 
 
 @pytest.fixture(scope="module")
