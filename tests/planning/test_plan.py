@@ -182,3 +182,14 @@ def test_backends_plan_valid_paths(backend: str) -> None:
         assert path.cost >= ours.cost - 1e-9
     else:
         assert path.cost == pytest.approx(ours.cost, rel=1e-9)
+
+
+def test_polygon_centroid_is_the_area_centroid() -> None:
+    from capnav.planning.goal import polygon_centroid
+
+    # A square with extra vertices crowded on one side: the vertex mean is pulled, the centroid not.
+    sq = np.array([[0, 0], [2, 0], [2, 0.5], [2, 1], [2, 1.5], [2, 2], [0, 2]], dtype=float)
+    assert polygon_centroid(sq) == pytest.approx([1.0, 1.0])
+    assert polygon_centroid(sq[::-1]) == pytest.approx([1.0, 1.0])  # either orientation
+    assert polygon_centroid(np.array([[1.0, 2.0]])) == pytest.approx([1.0, 2.0])
+    assert polygon_centroid(np.array([[0.0, 0.0], [2.0, 2.0]])) == pytest.approx([1.0, 1.0])

@@ -98,9 +98,22 @@ def _distances(points: NDArray[np.float64], fp: NDArray[np.float64], chunk: int 
     return out
 
 
+def polygon_centroid(fp: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Area centroid of a simple polygon (the vertex mean is biased where a hull has many vertices);
+    the vertex mean for degenerate footprints (a point, a segment, zero area)."""
+    if len(fp) >= 3:
+        x, y = fp[:, 0], fp[:, 1]
+        xn, yn = np.roll(x, -1), np.roll(y, -1)
+        cross = x * yn - xn * y
+        area = cross.sum() / 2.0
+        if abs(area) > 1e-12:
+            return np.array([((x + xn) * cross).sum(), ((y + yn) * cross).sum()]) / (6.0 * area)
+    return np.asarray(fp.mean(axis=0), dtype=np.float64)
+
+
 def _pose(cell: NDArray[np.intp], xy: NDArray[np.float64], fp: NDArray[np.float64], within: bool, reason: str,
           dist: float, cost: float) -> GoalPose:
-    centre = fp.mean(axis=0)
+    centre = polygon_centroid(fp)
     d = centre - xy
     yaw = float(np.arctan2(d[1], d[0])) if np.hypot(*d) > 1e-9 else 0.0
     return GoalPose(np.asarray(xy, dtype=np.float64), yaw, (int(cell[0]), int(cell[1])), within, reason, dist, cost)
