@@ -14,7 +14,6 @@ from capnav.sim.layout import FloorPlan, Rect, generate_floorplan
 from capnav.sim.manifest import Door, ObjectInstance, Room, SceneManifest
 from capnav.sim.navgrid import NavGrid
 from capnav.sim.palette import (
-    BOOK_COLORS,
     CATEGORY_STYLE,
     COLORS,
     ROLE_COLORS,
@@ -143,12 +142,16 @@ def _walls(plan: FloorPlan, t: float) -> tuple[RectSet, list[WallFace]]:
                 else:
                     p0, p1, n = (face, fa), (face, fb), (sign, 0.0)
                 faces.append(WallFace(k, p0, p1, n))
-    for d in plan.doors:  # jambs: the wall's cut ends at both sides of the opening
-        for end, nsign in ((d.lo, 1.0), (d.hi, -1.0)):
-            if d.axis == "x":
-                faces.append(WallFace(d.rooms[0], (d.coord - h, end), (d.coord + h, end), (0.0, nsign)))
-            else:
-                faces.append(WallFace(d.rooms[0], (end, d.coord - h), (end, d.coord + h), (nsign, 0.0)))
+    for d in plan.doors:  # jambs: the wall's cut ends at both sides of the opening, each room its half
+        for room in d.rooms:
+            r = plan.rooms[room]
+            side = 1.0 if (r.x0 if d.axis == "x" else r.y0) >= d.coord - 1e-9 else -1.0  # room beyond +coord?
+            lo, hi = sorted((d.coord, d.coord + side * h))
+            for end, nsign in ((d.lo, 1.0), (d.hi, -1.0)):
+                if d.axis == "x":
+                    faces.append(WallFace(room, (lo, end), (hi, end), (0.0, nsign)))
+                else:
+                    faces.append(WallFace(room, (end, lo), (end, hi), (nsign, 0.0)))
     return RectSet.from_lists(centers, sizes, [0.0] * len(centers)), faces
 
 
@@ -177,8 +180,6 @@ def _appearance(cat: str, rng: np.random.Generator, used: dict[str, list[str]]) 
         (wood if rng.random() < 0.6 else ROLE_COLORS["dark"])
     if cat in ("table", "coffee table", "desk", "nightstand", "stool", "chair") and material == "wood":
         roles["legs"] = main
-    for k, c in enumerate(BOOK_COLORS):
-        roles[f"book:{k}"] = c
     return name, material, roles
 
 

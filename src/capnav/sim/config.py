@@ -39,6 +39,7 @@ class CameraConfig:
     far: float = 20.0
     shadows: bool = False  # the tiny renderer's shadow pass halves the frame rate
     frame_rate: float = 10.0  # timestamps of rendered frames are index / frame_rate
+    room_culling: bool = True  # hide rooms no chain of doors makes visible (same pixels, ~2x faster)
 
     def __post_init__(self) -> None:
         if not (16 <= self.width <= 4096 and 16 <= self.height <= 4096):

@@ -214,15 +214,16 @@ def bookshelf(rng: np.random.Generator, w: float, d: float, h: float, v: str) ->
     for k in range(n + 1):
         parts.append(box(0, 0, 0.02 + k * (h - 0.04) / n, w - 2 * t, d, t))
     fill = 0.8 if v == "full" else 0.45
-    for k in range(n):
+    inner = w - 2 * t
+    for k in range(n):  # books: a few textured blocks per shelf (one box per book would cost ~10x more)
         z0 = 0.02 + k * (h - 0.04) / n + t / 2
         x = -w / 2 + t
-        while x < w / 2 - t - 0.05:
-            bw = float(rng.uniform(0.025, 0.06))
-            if rng.random() < fill and x + bw < w / 2 - t:
-                bh = float(rng.uniform(0.18, 0.3))
-                parts.append(box(x + bw / 2, 0.02, z0 + bh / 2, bw, d * 0.7, bh, f"book:{int(rng.integers(8))}"))
-            x += bw + 0.003
+        while x < w / 2 - t - 0.1:
+            bw = min(float(rng.uniform(0.15, 0.45)) * inner, w / 2 - t - x)
+            if rng.random() < fill:
+                bh = float(rng.uniform(0.2, 0.3))
+                parts.append(box(x + bw / 2, 0.02, z0 + bh / 2, bw, d * 0.7, bh, f"books:{int(rng.integers(8))}"))
+            x += bw + 0.02
     return parts
 
 

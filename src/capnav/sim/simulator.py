@@ -15,6 +15,7 @@ from capnav.sim.agent import Agent
 from capnav.sim.apartment import Apartment, generate_apartment
 from capnav.sim.camera import linear_depth, projection_matrix, view_matrix
 from capnav.sim.config import SimConfig
+from capnav.sim.culling import RoomCuller
 from capnav.sim.manifest import SceneManifest
 from capnav.sim.navgrid import NavGrid
 from capnav.sim.noise import apply_depth_noise
@@ -35,6 +36,9 @@ class Simulator:
         self._obstacles: RectSet = apartment.obstacles()
         self._grids: dict[float, NavGrid] = {}
         self.world = BulletWorld(apartment, textures=self.config.textures)
+        cam = self.config.camera
+        self._culler = RoomCuller(apartment.plan, self.config.layout.wall_height, cam.near) if cam.room_culling \
+            else None
 
     @classmethod
     def from_seed(cls, seed: int, config: SimConfig | None = None) -> Simulator:
@@ -64,6 +68,8 @@ class Simulator:
         T = check_pose(T_wc, frame=index)
         K = K if K is not None else self.intrinsics
         cam = self.config.camera
+        if self._culler is not None:
+            self.world.show_rooms(self._culler.visible(T, K))
         rgba, buf, seg = self.world.render(K.width, K.height, view_matrix(T), projection_matrix(K, cam.near, cam.far),
                                            shadows=cam.shadows)
         uid = np.where(seg >= 0, seg & 0xFFFFFF, -1)

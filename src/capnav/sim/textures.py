@@ -11,7 +11,7 @@ import zlib
 import numpy as np
 from numpy.typing import NDArray
 
-PATTERNS = ("plain", "wood", "fabric", "leather", "velvet", "metal", "marble", "ceramic", "plastic", "glass",
+PATTERNS = ("books", "plain", "wood", "fabric", "leather", "velvet", "metal", "marble", "ceramic", "plastic", "glass",
             "parquet", "tiles", "carpet", "paper", "laminate", "cotton", "terracotta", "acrylic")
 # Materials map to a pattern; unknown materials render plain.
 MATERIAL_PATTERN = {"stainless steel": "metal"}
@@ -59,6 +59,19 @@ def texture(pattern: str, rgb: tuple[int, int, int], n: int = 64) -> NDArray[np.
         f = 1.0 - 0.35 * (((xx * 2) % 1 < 0.04) | ((yy * 2) % 1 < 0.04)) + 0.04 * _noise(rng, n, 8)
     elif pattern == "carpet":
         f = 0.85 + 0.15 * rng.random((n, n)) * _noise(rng, n, 8)
+    elif pattern == "books":  # vertical spines of random widths and colours; rgb only seeds the variant
+        from capnav.sim.palette import BOOK_COLORS
+
+        img = np.zeros((n, n, 3))
+        x = 0
+        while x < n:
+            bw = int(rng.integers(3, 8))
+            img[:, x:x + bw] = BOOK_COLORS[int(rng.integers(len(BOOK_COLORS)))]
+            img[:, x + bw - 1:x + bw] *= 0.6  # a dark gap between books
+            top = int(rng.integers(0, n // 5))
+            img[:top, x:x + bw] = 30  # shorter books leave shadow above
+            x += bw
+        return img.astype(np.uint8)
     elif pattern in ("paper", "laminate", "terracotta"):
         f = 0.93 + 0.07 * _noise(rng, n, 8)
     img = np.clip(np.asarray(rgb, dtype=np.float64)[None, None, :] * f[:, :, None], 0, 255)

@@ -96,14 +96,21 @@ class BulletWorld:
         self.textures = textures
         self.tile = tile
         uid_to_instance: dict[int, tuple[int, int]] = {}
+        # the colour each visual (body, link) was created with, to restore after hiding its room
+        self._colors: dict[int, list[tuple[int, list[float]]]] = {}
+        self.room_bodies: list[list[int]] = [[] for _ in apt.plan.rooms]
         try:
-            self._build_structure(apt)
+            # Creation order is drawing order: near occluders first lets the renderer's depth test
+            # skip shading some of the floor/wall pixels hidden behind furniture.
             for o in apt.objects:
                 uid = self._build_object(o)
                 uid_to_instance[uid] = (o.id, BY_NAME[o.category].id)
+                self.room_bodies[o.room].append(uid)
+            self._build_structure(apt)
         except Exception:
             self.close()
             raise
+        self.shown = set(range(len(self.room_bodies)))
         n = max(uid_to_instance, default=0) + 2
         self.instance_lut = np.zeros(n, dtype=np.int32)  # index: body uid + 1 (so -1 -> 0)
         self.category_lut = np.zeros(n, dtype=np.int32)
@@ -126,6 +133,7 @@ class BulletWorld:
         vis = p.createVisualShape(p.GEOM_MESH, vertices=mesh.v, indices=mesh.idx, uvs=mesh.uv, normals=mesh.n,
                                   rgbaColor=[1, 1, 1, 1] if textured else _rgba(rgb), physicsClientId=self.client)
         uid = int(p.createMultiBody(0, -1, vis, physicsClientId=self.client))
+        self._colors[uid] = [(-1, [1.0, 1.0, 1.0, 1.0] if textured else _rgba(rgb))]
         if textured and pattern is not None:
             p.changeVisualShape(uid, -1, textureUniqueId=self.texture_id(pattern, rgb), physicsClientId=self.client)
         return uid
@@ -140,8 +148,8 @@ class BulletWorld:
                     floor.quad(np.array([[x0, y0, 0], [x1, y0, 0], [x1, y1, 0], [x0, y1, 0]]), (0, 0, 1))
                     ceil.quad(np.array([[x0, y0, H], [x0, y1, H], [x1, y1, H], [x1, y0, H]]), (0, 0, -1))
             pattern, rgb = apt.floor_styles[k]
-            self._mesh_body(floor, rgb, pattern)
-            self._mesh_body(ceil, CEILING, None)
+            self.room_bodies[k].append(self._mesh_body(floor, rgb, pattern))
+            self.room_bodies[k].append(self._mesh_body(ceil, CEILING, None))
             walls = Mesh()
             for f in (f for f in apt.wall_faces if f.room == k):
                 p0, p1 = np.array(f.p0), np.array(f.p1)
@@ -155,7 +163,7 @@ class BulletWorld:
                         walls.quad(np.array([[qa[0], qa[1], z0], [qb[0], qb[1], z0], [qb[0], qb[1], z1],
                                              [qa[0], qa[1], z1]]), (f.normal[0], f.normal[1], 0.0))
             if walls.v:
-                self._mesh_body(walls, apt.wall_colors[k], None)
+                self.room_bodies[k].append(self._mesh_body(walls, apt.wall_colors[k], None))
 
     # -- furniture -------------------------------------------------------------------------
     def _part_shape(self, part: Part, rgb: RGB) -> int:
@@ -179,12 +187,19 @@ class BulletWorld:
             return build_mesh_body(self, o)
         p = self.p
         parts = o.model.parts
-        shapes, patterns = [], []
+        shapes, patterns, colors = [], [], []
         for part in parts:
             rgb = o.roles.get(part.role, o.roles["main"])
-            textured = self.textures and part.role in _TEXTURED_ROLES
-            shapes.append(self._part_shape(part, (255, 255, 255) if textured else rgb))
-            patterns.append((o.material, rgb) if textured else None)
+            pattern: tuple[str, RGB] | None = None
+            if part.role.startswith("books:"):  # a block of book spines: always textured
+                k = int(part.role.split(":")[1])
+                pattern = ("books", (k, k, k))
+            elif self.textures and part.role in _TEXTURED_ROLES:
+                pattern = (o.material, rgb)
+            color = (255, 255, 255) if pattern is not None else rgb
+            shapes.append(self._part_shape(part, color))
+            patterns.append(pattern)
+            colors.append(_rgba(color))
         n = len(parts)
         kw: dict[str, Any] = dict(
             linkMasses=[0.0] * n, linkCollisionShapeIndices=[-1] * n, linkVisualShapeIndices=shapes,
@@ -194,12 +209,26 @@ class BulletWorld:
         quat = p.getQuaternionFromEuler([0.0, 0.0, o.yaw])
         uid = int(p.createMultiBody(0, -1, -1, basePosition=[o.x, o.y, 0.0], baseOrientation=quat,
                                     physicsClientId=self.client, **kw))
+        self._colors[uid] = list(enumerate(colors))
         for link, pat in enumerate(patterns):
             if pat is not None:
                 p.changeVisualShape(uid, link, textureUniqueId=self.texture_id(*pat), physicsClientId=self.client)
         return uid
 
     # -- rendering -------------------------------------------------------------------------
+    def show_rooms(self, rooms: set[int]) -> None:
+        """Show exactly ``rooms`` (structure and furniture); the renderer skips alpha-0 visuals."""
+        p = self.p
+        for k, bodies in enumerate(self.room_bodies):
+            want = k in rooms
+            if want == (k in self.shown):
+                continue
+            for uid in bodies:
+                for link, rgba in self._colors[uid]:
+                    color = rgba if want else [rgba[0], rgba[1], rgba[2], 0.0]
+                    p.changeVisualShape(uid, link, rgbaColor=color, physicsClientId=self.client)
+        self.shown = set(rooms)
+
     def render(self, width: int, height: int, view: list[float], proj: list[float], shadows: bool = False,
                segmentation: bool = True) -> tuple[NDArray[np.uint8], NDArray[np.float32], NDArray[np.int32]]:
         """Raw (rgba uint8, depth buffer float32 in [0, 1], body-uid segmentation int32) images."""
