@@ -29,16 +29,18 @@ from capnav.planning import PlannerConfig, build_costmap, navigate_to
 TARGET = {"truth": 0.99, "mapped": 0.95}
 
 
-def mapped_occupancy(sim: Any, seed: int, cache: Path | None) -> OccupancyGrid:
-    """Explore, map (CapNav's mapping stage) and return the map's occupancy; cached per seed."""
+def mapped_occupancy(sim: Any, seed: int, cache: Path | None, max_frames: int | None, noisy: bool) -> OccupancyGrid:
+    """Explore, map (CapNav's mapping stage) and return the map's occupancy; cached per setting."""
     from capnav.io.mapfile import load_map, save_map
     from capnav.mapping import build_map
-    from capnav.sim import explore
+    from capnav.sim import ExploreConfig, explore
 
-    path = None if cache is None else cache / f"apartment_{seed}.capnav"
+    tag = f"{'' if max_frames is None else f'_f{max_frames}'}{'_noisy' if noisy else ''}"
+    path = None if cache is None else cache / f"apartment_{seed}{tag}.capnav"
     if path is not None and path.exists():
         return load_map(path).occupancy
-    cmap = build_map(explore(sim), progress=False, meta={"scene_seed": seed})
+    frames = explore(sim, ExploreConfig(max_frames=max_frames))
+    cmap = build_map(frames, progress=False, meta={"scene_seed": seed})
     if path is not None:
         save_map(cmap, path)
     return cmap.occupancy
@@ -92,20 +94,24 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0, help="seed of the starts")
     ap.add_argument("--occupancy", nargs="*", default=["truth", "mapped"], choices=["truth", "mapped"])
     ap.add_argument("--map-cache", type=Path, default=None, help="folder to keep the mapped apartments in")
+    ap.add_argument("--max-frames", type=int, default=None, help="map from at most this many exploration frames")
+    ap.add_argument("--depth-noise", action="store_true", help="Kinect-like depth noise in the mapped frames")
     args = ap.parse_args()
-    from capnav.sim import Simulator
+    from capnav.sim import DepthNoiseConfig, SimConfig, Simulator
 
     cfg = PlannerConfig()
     if args.map_cache is not None:
         args.map_cache.mkdir(parents=True, exist_ok=True)
     print(f"# {cfg}")
     print(f"# starts per instance {args.starts}, start seed {args.seed}; success = stop within "
-          f"{SUCCESS_RADIUS_M} m of the true footprint")
+          f"{SUCCESS_RADIUS_M} m of the true footprint; mapping: max_frames={args.max_frames}, "
+          f"depth noise {'on' if args.depth_noise else 'off'}")
     rows, totals = [], {k: [0, 0] for k in args.occupancy}
     for seed in args.seeds:
-        sim = Simulator.from_seed(seed)
+        sim = Simulator.from_seed(seed, SimConfig(depth_noise=DepthNoiseConfig(enabled=args.depth_noise, seed=seed)))
         for kind in args.occupancy:
-            occ = sim.obstacles() if kind == "truth" else mapped_occupancy(sim, seed, args.map_cache)
+            occ = sim.obstacles() if kind == "truth" else mapped_occupancy(sim, seed, args.map_cache, args.max_frames,
+                                                                             args.depth_noise)
             r = run(sim, occ, args.starts, args.seed, cfg)
             totals[kind][0] += r["ok"]
             totals[kind][1] += r["trials"]
