@@ -1,0 +1,55 @@
+"""``capnav caption MAP --dataset DIR``: choose views, caption and embed every object of a map."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("caption")
+    def caption_cmd(
+        map_path: Path = typer.Argument(..., help="map file written by `capnav map`"),
+        dataset: Path | None = typer.Option(None, "--dataset", help="the dataset folder the map was built from "
+                                            "(for the views); without it existing views are kept"),
+        captioner: str = typer.Option("offline", help="offline | gemini | openai | hf-local"),
+        model: str | None = typer.Option(None, help="model name for gemini / openai"),
+        base_url: str | None = typer.Option(None, help="endpoint for gemini / openai (e.g. a local server)"),
+        model_path: Path | None = typer.Option(None, help="local folder for hf-local"),
+        embedder: str = typer.Option("minilm", help="minilm | onnx | sentence-transformers | bge-m3 | flag"),
+        embedder_path: Path | None = typer.Option(None, help="local model folder for non-default embedders"),
+        output: Path | None = typer.Option(None, "-o", "--output", help="write here instead of over MAP"),
+        reselect_views: bool = typer.Option(False, help="choose views again for every object"),
+        progress: bool = typer.Option(True, help="show progress bars"),
+    ) -> None:
+        """Fill captions and embeddings (paper 3.3); the caption cache makes reruns free."""
+        from rich.console import Console
+
+        from capnav.io.mapfile import load_map, save_map
+        from capnav.language import create_captioner, create_embedder, describe_map
+
+        kw: dict[str, object] = {}
+        if model:
+            kw["model"] = model
+        if base_url:
+            kw["base_url"] = base_url
+        if model_path is not None:
+            kw["path"] = model_path
+        cap = create_captioner(captioner, **kw)
+        emb = create_embedder(embedder, **({"path": embedder_path} if embedder_path is not None else {}))
+        cmap = load_map(map_path)
+        reader = None
+        if dataset is not None:
+            from capnav.io.dataset import DatasetReader
+
+            reader = DatasetReader(dataset)
+        rep = describe_map(cmap, reader, cap, emb, progress=progress, reselect_views=reselect_views)
+        out = output or map_path
+        save_map(cmap, out)
+        con = Console(stderr=True)
+        con.print(f"{out}: {rep.objects} objects, {rep.captions_new} new captions, {rep.captions_cached} cached, "
+                  f"{len(rep.fallbacks)} fallbacks; captioner {cap.model_id}, embedder {emb.model_id} "
+                  f"({', '.join(f'{k} {v:.1f} s' for k, v in rep.seconds.items())})", highlight=False)
+        for oid, why in rep.fallbacks[:10]:
+            con.print(f"[yellow]object {oid}:[/] {why}", highlight=False)

@@ -1,0 +1,87 @@
+"""``capnav query MAP "instruction" [--robot X,Y] [--json]``: which object, why, and the runners-up."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import typer
+
+from capnav.core.errors import InputError
+
+
+def parse_xy(text: str | None) -> tuple[float, float] | None:
+    if text is None:
+        return None
+    try:
+        x, y = (float(v) for v in text.split(","))
+    except ValueError:
+        raise InputError(f"--robot must be X,Y in metres (e.g. 1.5,2.0), got {text!r}") from None
+    return (x, y)
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("query")
+    def query_cmd(
+        map_path: Path = typer.Argument(..., help="a captioned map (see `capnav caption`)"),
+        instruction: str = typer.Argument(..., help='e.g. "go to the white sofa with curved edges"'),
+        robot: str | None = typer.Option(None, "--robot", help="robot position X,Y in metres"),
+        as_json: bool = typer.Option(False, "--json", help="print the result as JSON"),
+        verifier: str = typer.Option("offline", help="offline | none | gemini | openai | hf-local"),
+        no_heuristic: bool = typer.Option(False, help="ablation: no attribute heuristic (pure semantic)"),
+        embedder: str = typer.Option("auto", help="auto (the map's default model) or a backend name"),
+        embedder_path: Path | None = typer.Option(None, help="local model folder for non-default embedders"),
+    ) -> None:
+        """Retrieve the object an instruction describes (paper 3.4)."""
+        from capnav.io.mapfile import load_map
+        from capnav.language import create_embedder
+        from capnav.language.onnx_embedder import MINILM_MODEL_ID
+        from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
+        from capnav.retrieval.result import QueryResult
+
+        xy = parse_xy(robot)
+        cmap = load_map(map_path)
+        if embedder == "auto":
+            models = {o.embedding_model for o in cmap.objects if o.embedding_model}
+            if not models:
+                raise InputError(f"{map_path} has no captions/embeddings: run `capnav caption {map_path} "
+                                 "--dataset DIR` first")
+            if models != {MINILM_MODEL_ID}:
+                raise InputError(f"{map_path} was embedded with {sorted(models)}; pass --embedder and "
+                                 "--embedder-path for that model")
+            emb = create_embedder("minilm")
+        else:
+            emb = create_embedder(embedder, **({"path": embedder_path} if embedder_path is not None else {}))
+        cfg = RetrievalConfig(use_verifier=verifier != "none", use_attribute_heuristic=not no_heuristic)
+        res: QueryResult = Retriever(cmap, emb, create_verifier(verifier), cfg).query(instruction, robot_xy=xy)
+        if as_json:
+            typer.echo(json.dumps(res.to_dict(), indent=2))
+            return
+        _print(res)
+
+
+def _print(res: object) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    from capnav.retrieval.result import QueryResult
+
+    assert isinstance(res, QueryResult)
+    con = Console()
+    if res.chosen is None:
+        con.print(f"[bold red]not found[/]: {res.instruction!r}", highlight=False)
+    else:
+        o = res.chosen
+        con.print(f"[bold green]object {o.id}[/] ({o.label}) at x={o.position[0]:.2f}, y={o.position[1]:.2f} m",
+                  highlight=False)
+        con.print(f"  caption: {o.caption}", highlight=False)
+        dist = f", {res.distance_m:.2f} m from the robot" if res.distance_m is not None else ""
+        con.print(f"  similarity {res.score:.3f}, mode {res.mode}"
+                  f"{', predicate ' + res.predicate if res.predicate else ''}{dist}", highlight=False)
+    con.print(f"  why: {res.reason}", highlight=False)
+    if res.ranked:
+        t = Table("id", "label", "similarity", "caption", title="runners-up", title_justify="left")
+        for obj, s in res.ranked:
+            t.add_row(str(obj.id), obj.label, f"{s:.3f}", obj.caption or "")
+        con.print(t)
+    con.print("  timings: " + ", ".join(f"{k} {v * 1e3:.1f} ms" for k, v in res.timings.items()), highlight=False)
