@@ -145,8 +145,8 @@ def _walls(plan: FloorPlan, t: float) -> tuple[RectSet, list[WallFace]]:
     for d in plan.doors:  # jambs: the wall's cut ends at both sides of the opening, each room its half
         for room in d.rooms:
             r = plan.rooms[room]
-            side = 1.0 if (r.x0 if d.axis == "x" else r.y0) >= d.coord - 1e-9 else -1.0  # room beyond +coord?
-            lo, hi = sorted((d.coord, d.coord + side * h))
+            sgn = 1.0 if (r.x0 if d.axis == "x" else r.y0) >= d.coord - 1e-9 else -1.0  # room beyond +coord?
+            lo, hi = sorted((d.coord, d.coord + sgn * h))
             for end, nsign in ((d.lo, 1.0), (d.hi, -1.0)):
                 if d.axis == "x":
                     faces.append(WallFace(room, (lo, end), (hi, end), (0.0, nsign)))
