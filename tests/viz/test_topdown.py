@@ -53,3 +53,13 @@ def test_json_has_the_same_content(tmp_path) -> None:
     assert rec["objects"][1]["short_label"] == short_label(objects[1]) == "2 coffee table"
     assert rec["path"][-1] == [1.3, 2.0] and rec["grid"]["rows"] == 80
     assert rec["occupancy_counts"]["occupied"] == int((occ.cells == OCCUPIED).sum())
+
+
+def test_abandoned_plans_are_drawn(tmp_path) -> None:
+    occ, objects = scene()
+    args = (occ, objects, 1, np.array([[0.5, 0.5], [4.2, 1.8]]), None, (0.5, 0.5), (4.2, 1.8), "t")
+    a = draw_navigation(*args, tmp_path / "a.png")
+    b = draw_navigation(*args, tmp_path / "b.png", abandoned=[np.array([[0.5, 0.5], [0.5, 3.5], [3.0, 3.5]])])
+    ia = np.asarray(Image.open(a).convert("L")).astype(int)
+    ib = np.asarray(Image.open(b).convert("L")).astype(int)
+    assert ia.shape == ib.shape and (np.abs(ia - ib) > 30).sum() > 100

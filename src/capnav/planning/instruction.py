@@ -99,5 +99,6 @@ def run_instruction(cmap: CapNavMap, sim: Simulator, retriever: Retriever, instr
             out_dir, stem, occ, cmap.objects, chosen.id if chosen else None,
             None if nav is None else nav.waypoints, None if nav is None else nav.trajectory, start,
             agent.pose, title, goal=None if nav is None or nav.goal is None else (*nav.goal.xy, nav.goal.yaw),
-            reach=cfg.reach, **{k: v for k, v in out.to_dict().items() if k != "start"})
+            reach=cfg.reach, abandoned=[] if nav is None else [p.waypoints for p in nav.plans[:-1]],
+            **{k: v for k, v in out.to_dict().items() if k != "start"})
     return out

@@ -43,11 +43,13 @@ def occupancy_rgb(occ: OccupancyGrid) -> NDArray[np.float64]:
 def draw_navigation(occ: OccupancyGrid, objects: Sequence[MapObject], chosen_id: int | None,
                     path_xy: NDArray[np.floating] | None, trajectory_xy: NDArray[np.floating] | None,
                     start: Pose | None, end: Pose | None, title: str, out_png: str | Path,
-                    goal: Pose | None = None, reach: float | None = None, dpi: int = 120) -> Path:
+                    goal: Pose | None = None, reach: float | None = None, dpi: int = 120,
+                    abandoned: Sequence[NDArray[np.floating]] = ()) -> Path:
     """Draw the picture and write it atomically to ``out_png``; returns the path.
 
     ``start`` / ``end`` / ``goal`` are (x, y) or (x, y, yaw): with a yaw an arrow shows the heading.
-    ``reach`` draws the success radius around the chosen object's footprint.
+    ``reach`` draws the success radius around the chosen object's footprint; ``abandoned`` are
+    earlier plans given up after a collision (thin dotted), so replanning is visible.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -75,6 +77,11 @@ def draw_navigation(occ: OccupancyGrid, objects: Sequence[MapObject], chosen_id:
                 bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.7})
         if chosen and reach:
             _draw_reach(ax, fp, reach)
+    for k, a in enumerate(abandoned):
+        q = np.asarray(a, dtype=np.float64)
+        if len(q):
+            ax.plot(q[:, 0], q[:, 1], ":", color="#7f7f7f", lw=1.1, zorder=4,
+                    label="abandoned plan" if k == 0 else None)
     if path_xy is not None and len(path_xy):
         p = np.asarray(path_xy, dtype=np.float64)
         ax.plot(p[:, 0], p[:, 1], "--", color=PATH, lw=1.4, label="planned path", zorder=6)
@@ -149,11 +156,11 @@ def write_navigation(out_dir: str | Path, stem: str, occ: OccupancyGrid, objects
                      chosen_id: int | None, path_xy: NDArray[np.floating] | None,
                      trajectory_xy: NDArray[np.floating] | None, start: Pose | None, end: Pose | None,
                      title: str, goal: Pose | None = None, reach: float | None = None,
-                     **extra: Any) -> tuple[Path, Path]:
+                     abandoned: Sequence[NDArray[np.floating]] = (), **extra: Any) -> tuple[Path, Path]:
     """Both files: ``<stem>.png`` and ``<stem>.json`` in ``out_dir``."""
     out = Path(out_dir)
     png = draw_navigation(occ, objects, chosen_id, path_xy, trajectory_xy, start, end, title, out / f"{stem}.png",
-                          goal=goal, reach=reach)
+                          goal=goal, reach=reach, abandoned=abandoned)
     rec = navigation_record(occ, objects, chosen_id, path_xy, trajectory_xy, start, end, title,
                             goal=None if goal is None else [round(float(v), 4) for v in goal], **extra)
     js = out / f"{stem}.json"
