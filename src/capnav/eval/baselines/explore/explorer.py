@@ -1,0 +1,330 @@
+"""The shared frontier-exploration core: observe, map, pick a frontier, drive there step by step.
+
+Every motion is one discrete agent action (turn or forward step, as in Habitat's object-goal
+task) and is followed by an observation, so the online map and the sightings grow while the agent
+moves, and a ``stop`` predicate can end the search the moment the goal is in view. The budget
+counts actions; running out is a timeout, running out of reachable frontiers means the whole
+reachable space was seen.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from capnav.core.errors import CapNavError, InputError
+from capnav.core.frame import Frame
+from capnav.core.grid import FREE, OccupancyGrid
+from capnav.eval.baselines.explore.frontier import Frontier, find_frontiers
+from capnav.eval.baselines.explore.online_map import OnlineMap, OnlineMapConfig
+from capnav.eval.baselines.explore.sighting import Sighting, lift
+from capnav.planning import Costmap, PlannerConfig, build_costmap, plan_path, select_goal
+from capnav.planning.search import cost_field
+
+#: ``score(frontiers, explorer) -> one score per frontier``; the highest reachable one is chosen.
+FrontierScorer = Callable[[Sequence[Frontier], "FrontierExplorer"], NDArray[np.float64]]
+#: ``stop(explorer) -> True`` ends the current drive / search (e.g. the goal is in view).
+StopCheck = Callable[["FrontierExplorer"], bool]
+
+
+class Status(Enum):
+    ARRIVED = "arrived"
+    STOPPED = "stopped"  # the stop predicate fired
+    BUDGET = "budget"  # no actions left: a timeout
+    BLOCKED = "blocked"  # could not plan or kept colliding
+    EXHAUSTED = "exhausted"  # no reachable frontier left
+
+
+@dataclass(frozen=True)
+class ExplorerConfig:
+    """Exploration behaviour. ``planner`` is the shared A* planner's config (same as CapNav's)."""
+
+    map: OnlineMapConfig = field(default_factory=OnlineMapConfig)
+    planner: PlannerConfig = field(default_factory=PlannerConfig)
+    max_steps: int | None = None  # actions per subgoal; None = the harness's ctx.max_steps
+    look_around: bool = True  # a full turn in place at the start and at each reached frontier
+    replan_every: int = 6  # forward steps between replans (the map grows while driving)
+    min_frontier_cells: int = 4
+    frontier_tile: float = 1.5  # m, longest side of one frontier cluster
+    visited_radius: float = 0.75  # m, a frontier whose target is this close to a reached one is spent
+    max_collisions: int = 4  # per drive, before the target is given up
+    min_sighting_points: int = 10  # valid depth pixels a detection needs to be lifted
+    goal_snap: float = 0.5  # m, a goal inside the inflated obstacles moves to the nearest free cell
+
+    def __post_init__(self) -> None:
+        if self.max_steps is not None and self.max_steps < 1:
+            raise InputError(f"max_steps must be >= 1, got {self.max_steps}")
+        if self.replan_every < 1 or self.min_frontier_cells < 1 or self.max_collisions < 1:
+            raise InputError("replan_every, min_frontier_cells and max_collisions must be >= 1")
+
+
+class FrontierExplorer:
+    """One episode's exploration state: online map, sightings, spent frontiers, action budget."""
+
+    def __init__(self, agent: Any, detector: Any, config: ExplorerConfig | None = None,
+                 online_map: OnlineMap | None = None) -> None:
+        """``detector`` None: map only, no sightings. ``online_map``: continue an existing map
+        (e.g. one built from the exploration stream) instead of starting empty."""
+        self.agent = agent
+        self.detector = detector
+        self.config = cfg = config or ExplorerConfig()
+        x, y, _ = (float(v) for v in agent.pose)
+        self.map = online_map if online_map is not None else OnlineMap((x, y), cfg.map)
+        self.sightings: list[Sighting] = []
+        self.new_sightings: list[Sighting] = []
+        self.spent: list[tuple[float, float]] = []
+        self.budget = 0
+        self.steps = 0
+        self.frame: Frame | None = None
+        agent_cfg = getattr(agent, "cfg", None) or getattr(agent, "config", None)
+        self.turn = math.radians(float(getattr(agent_cfg, "turn_deg", 30.0)))
+        self.forward = float(getattr(agent_cfg, "forward_step", 0.25))
+
+    # ------------------------------------------------------------------ budget and senses
+    def begin(self, max_steps: int) -> None:
+        """Start a subgoal with a fresh action budget (map and sightings are kept)."""
+        self.budget = int(self.config.max_steps or max_steps)
+        self.steps = 0
+
+    @property
+    def xy(self) -> tuple[float, float]:
+        p = self.agent.pose
+        return float(p[0]), float(p[1])
+
+    def observe(self) -> list[Sighting]:
+        """Look: fuse depth into the map, run the detector, remember the lifted sightings."""
+        frame = self.agent.observe()
+        self.frame = frame
+        self.map.update(frame)
+        self.map.mark_free_disk(self.xy)
+        dets = self.detector.detect(frame) if self.detector is not None else []
+        self.new_sightings = lift(frame, dets, self.config.min_sighting_points)
+        self.sightings.extend(self.new_sightings)
+        return self.new_sightings
+
+    def act(self, action: str) -> bool:
+        """One action then one observation; False when a forward step hit something."""
+        ok = bool(self.agent.step(action))
+        self.budget -= 1
+        self.steps += 1
+        if not ok:
+            x, y, yaw = (float(v) for v in self.agent.pose)
+            r = self.config.planner.robot_radius + 0.06
+            self.map.mark_obstacle((x + r * math.cos(yaw), y + r * math.sin(yaw)))
+        self.observe()
+        return ok
+
+    def look_around(self, stop: StopCheck | None = None) -> Status:
+        """A full turn in place, observing at every heading."""
+        for _ in range(max(1, round(2 * math.pi / self.turn)) - 1):
+            if self.budget <= 0:
+                return Status.BUDGET
+            self.act("turn_left")
+            if stop is not None and stop(self):
+                return Status.STOPPED
+        return Status.ARRIVED
+
+    # ------------------------------------------------------------------ planning
+    def grid(self) -> OccupancyGrid:
+        return self.map.grid()
+
+    def costmap(self, grid: OccupancyGrid) -> Costmap:
+        return build_costmap(grid, self.config.planner)
+
+    def frontiers(self, grid: OccupancyGrid, cm: Costmap) -> list[Frontier]:
+        """Reachable, unspent frontiers, cheapest path first.
+
+        Path costs come from the shared planner's cost field, so a frontier seen through a door
+        whose posts the map has not resolved yet stays reachable across unknown cells (at the
+        planner's unknown cost) instead of being dropped; targets are always known-free cells.
+        """
+        passable = np.isfinite(cm.weights)
+        start = _start_cell(grid, passable & (grid.cells == FREE), self.xy)
+        field, _ = cost_field(cm.weights, start)
+        known = passable & (grid.cells == FREE)
+        dist = np.where(known, field * grid.spec.resolution, np.inf)
+        out = find_frontiers(grid, known, dist, self.config.min_frontier_cells, self.config.frontier_tile)
+        r2 = self.config.visited_radius**2
+        return [f for f in out if math.isfinite(f.path_distance)
+                and not any((f.target_xy[0] - s[0]) ** 2 + (f.target_xy[1] - s[1]) ** 2 < r2 for s in self.spent)]
+
+    # ------------------------------------------------------------------ motion
+    def drive_to(self, goal_xy: tuple[float, float], stop: StopCheck | None = None, tolerance: float | None = None,
+                 goal_of: Callable[[], tuple[float, float] | None] | None = None) -> Status:
+        """Plan on the online map and drive with discrete actions, replanning every few steps.
+
+        ``goal_of`` (optional) re-reads the goal before each replan (an approach whose target
+        estimate improves as the agent gets closer); ``tolerance`` is the arrival radius.
+        """
+        tol = 0.6 * self.forward if tolerance is None else tolerance
+        collisions = idle = 0
+        while True:
+            if goal_of is not None:
+                g = goal_of()
+                goal_xy = g if g is not None else goal_xy
+            if math.dist(self.xy, goal_xy) <= tol:
+                return Status.ARRIVED
+            grid = self.grid()
+            cm = self.costmap(grid)
+            aim = _snap_goal(cm, goal_xy, self.config.goal_snap)
+            if aim is None:
+                return Status.BLOCKED
+            try:
+                path = plan_path(grid, self.xy, aim, self.config.planner, cm)
+            except CapNavError:
+                return Status.BLOCKED
+            before = self.steps
+            status = self._follow(path.waypoints, stop, max(tol, math.dist(aim, goal_xy)), goal_xy)
+            if status is None:
+                idle = idle + 1 if self.steps == before else 0
+                if idle >= 3:  # the plan keeps ending where the agent already is
+                    return Status.BLOCKED
+                continue
+            if status is Status.BLOCKED:
+                collisions += 1
+                if collisions >= self.config.max_collisions:
+                    return Status.BLOCKED
+                continue
+            return status
+
+    def _follow(self, waypoints: NDArray[np.float64], stop: StopCheck | None, tol: float,
+                goal_xy: tuple[float, float]) -> Status | None:
+        """Walk the waypoints for up to ``replan_every`` forward steps; None means 'replan'.
+
+        A waypoint counts as reached within 0.6 forward steps, or when a forward step towards it
+        no longer gets closer (a fixed step cannot land exactly on a point: without this rule
+        the agent would step back and forth across it).
+        """
+        forward = 0
+        reach = 0.6 * self.forward
+        for wp in waypoints[1:]:
+            target = (float(wp[0]), float(wp[1]))
+            while (d := math.dist(self.xy, target)) > reach:
+                if math.dist(self.xy, goal_xy) <= tol:
+                    return Status.ARRIVED
+                if forward >= self.config.replan_every:
+                    return None
+                if self.budget <= 0:
+                    return Status.BUDGET
+                x, y, yaw = (float(v) for v in self.agent.pose)
+                err = _wrap(math.atan2(target[1] - y, target[0] - x) - yaw)
+                progressed = True
+                if abs(err) > self.turn / 2:
+                    ok = self.act("turn_left" if err > 0 else "turn_right")
+                else:
+                    ok = self.act("move_forward")
+                    forward += 1
+                    progressed = math.dist(self.xy, target) < d - 1e-3
+                if stop is not None and stop(self):
+                    return Status.STOPPED
+                if not ok:
+                    return Status.BLOCKED
+                if not progressed:
+                    break
+        return Status.ARRIVED if math.dist(self.xy, goal_xy) <= max(tol, self.forward) else None
+
+    def explore(self, score: FrontierScorer, stop: StopCheck) -> Status:
+        """Frontier exploration until ``stop`` fires, the budget ends or no frontier is left."""
+        if self.frame is None:
+            self.observe()
+        if stop(self):
+            return Status.STOPPED
+        if self.config.look_around and not self.spent and self.steps == 0:
+            st = self.look_around(stop)
+            if st is not Status.ARRIVED:
+                return st
+        while self.budget > 0:
+            grid = self.grid()
+            fronts = self.frontiers(grid, self.costmap(grid))
+            if not fronts:
+                return Status.EXHAUSTED
+            scores = np.asarray(score(fronts, self), dtype=np.float64)
+            f = fronts[int(np.argmax(scores))]
+            st = self.drive_to(f.target_xy, stop)
+            self.spent.append(f.target_xy)
+            if st is Status.ARRIVED and self.config.look_around:
+                st = self.look_around(stop)
+            if st in (Status.STOPPED, Status.BUDGET):
+                return st
+        return Status.BUDGET
+
+    def approach(self, target: Callable[[], tuple[float, float] | None], stop_distance: float,
+                 stop: StopCheck | None = None) -> Status:
+        """Drive until within ``stop_distance`` of the (re-estimated) target, via a reachable
+        standing cell chosen by the shared planner's goal selection."""
+        def standing_cell() -> tuple[float, float] | None:
+            t = target()
+            if t is None:
+                return None
+            if math.dist(self.xy, t) <= stop_distance:
+                return self.xy
+            grid = self.grid()
+            try:
+                g = select_goal(grid, np.array([t]), self.xy, self.config.planner, self.costmap(grid))
+            except CapNavError:
+                return None
+            return float(g.xy[0]), float(g.xy[1])
+
+        first = standing_cell()
+        if first is None:
+            return Status.BLOCKED
+
+        def near_target(ex: FrontierExplorer) -> bool:
+            t = target()
+            return (t is not None and math.dist(ex.xy, t) <= stop_distance) or (stop is not None and stop(ex))
+
+        if near_target(self):
+            return Status.ARRIVED
+        st = self.drive_to(first, near_target, goal_of=standing_cell)
+        t = target()
+        if t is not None and math.dist(self.xy, t) <= stop_distance:
+            return Status.ARRIVED
+        return Status.STOPPED if st is Status.STOPPED else st
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+def _snap_goal(cm: Costmap, xy: tuple[float, float], max_dist: float) -> tuple[float, float] | None:
+    """``xy`` if the planner can stand there, else the nearest traversable cell centre within
+    ``max_dist`` (a node or frontier hugging a wall), else None."""
+    spec = cm.spec
+    rc = spec.to_cell(np.asarray(xy, dtype=np.float64))
+    if not spec.inside(rc):
+        return None
+    if np.isfinite(cm.weights[rc[0], rc[1]]):
+        return xy
+    k = int(np.ceil(max_dist / spec.resolution))
+    r0, c0 = max(int(rc[0]) - k, 0), max(int(rc[1]) - k, 0)
+    win = np.isfinite(cm.weights[r0:int(rc[0]) + k + 1, c0:int(rc[1]) + k + 1])
+    if not win.any():
+        return None
+    wr, wc = np.nonzero(win)
+    cells = np.stack([wr + r0, wc + c0], axis=1)
+    centres = spec.to_world(cells)
+    d = np.hypot(centres[:, 0] - xy[0], centres[:, 1] - xy[1])
+    i = int(np.argmin(d))
+    return (float(centres[i, 0]), float(centres[i, 1])) if d[i] <= max_dist else None
+
+
+def _start_cell(grid: OccupancyGrid, passable: NDArray[np.bool_], xy: tuple[float, float]) -> tuple[int, int]:
+    """The agent's cell, or the nearest passable cell when it stands in the inflation band."""
+    rc = grid.spec.to_cell(np.asarray(xy, dtype=np.float64))
+    r, c = int(rc[0]), int(rc[1])
+    if 0 <= r < passable.shape[0] and 0 <= c < passable.shape[1] and passable[r, c]:
+        return r, c
+    k = 12
+    r0, c0 = max(r - k, 0), max(c - k, 0)
+    win = passable[r0:r + k + 1, c0:c + k + 1]
+    if not win.any():
+        return r, c
+    wr, wc = np.nonzero(win)
+    i = int(np.argmin((wr + r0 - r) ** 2 + (wc + c0 - c) ** 2))
+    return int(wr[i] + r0), int(wc[i] + c0)
