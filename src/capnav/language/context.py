@@ -46,6 +46,7 @@ class ContextConfig:
     room_min_score: float = 0.35  # below this the room stays unknown
     wall_cells: int = 1  # occupied non-object cells on a segment that count as a wall
     object_margin: float = 0.15  # m around object boxes not counted as wall
+    los_range: float = 3.0  # m of box gap up to which walls between objects are checked
 
 
 def canonical_label(label: str) -> str:
@@ -81,31 +82,41 @@ class SceneContext:
         gap = np.maximum(0.0, np.maximum(self.lo[:, None] - self.hi[None], self.lo[None] - self.hi[:, None]))
         self.gap = np.hypot(gap[..., 0], gap[..., 1])
         self.visible = self._line_of_sight()
-        self.cue_distance = self._cue_distances()
+        self.room_score = self._room_scores()
         self.rooms = [self._room(i) for i in range(n)]
 
-    def _cue_distances(self) -> dict[int, NDArray[np.float64]]:
-        """Walking distance (m) from each room-cue object to every object (geodesic when a grid
-        is known: through free space and furniture, not through walls)."""
-        cue_ids = [k for k, lab in enumerate(self.labels) if any(lab in c for c in ROOM_CUES.values())]
-        out: dict[int, NDArray[np.float64]] = {}
-        if self.occupancy is None:
-            for k in cue_ids:
-                d = np.linalg.norm(self.xy - self.xy[k], axis=1)
-                out[k] = np.where(self.visible[k], d, np.inf)
-            return out
-        from capnav.language.rooms import box_min, geodesic_from_box, walkable_domain
+    def _room_scores(self) -> NDArray[np.float64]:
+        """(n, rooms) strongest cue per room type: max over cue objects of w * exp(-d^2 / 2 sigma^2),
+        d the walking distance (geodesic through free space and furniture, not walls, when a grid
+        is known). Cues of equal room and weight share one multi-source distance field."""
+        n = len(self.objects)
+        score = np.zeros((n, len(ROOM_CUES)))
+        groups: dict[tuple[int, float], list[int]] = {}
+        for k, lab in enumerate(self.labels):
+            for r, cues in enumerate(ROOM_CUES.values()):
+                if lab in cues:
+                    groups.setdefault((r, cues[lab]), []).append(k)
+        if not groups:
+            return score
+        sigma = self.config.room_sigma
+        if self.occupancy is not None:
+            from capnav.language.rooms import box_min, geodesic_from_boxes, walkable_domain
 
-        spec = self.occupancy.spec
-        domain = walkable_domain(self.occupancy, self.lo, self.hi)
-        # The inner half of each box: a box's rim may poke through the wall it stands against.
-        q = 0.25 * (self.hi - self.lo)
-        ilo, ihi = self.lo + q, self.hi - q
-        for k in cue_ids:
-            field = geodesic_from_box(domain, spec, ilo[k], ihi[k], limit_m=4 * self.config.room_sigma)
-            out[k] = np.array([box_min(field, spec, ilo[j], ihi[j]) for j in range(len(self.objects))])
-            out[k][k] = 0.0
-        return out
+            spec = self.occupancy.spec
+            domain = walkable_domain(self.occupancy, self.lo, self.hi)
+            # The inner half of each box: a box's rim may poke through the wall it stands against.
+            q = 0.25 * (self.hi - self.lo)
+            ilo, ihi = self.lo + q, self.hi - q
+        for (r, w), members in groups.items():
+            if self.occupancy is not None:
+                field = geodesic_from_boxes(domain, spec, ilo[members], ihi[members], limit_m=4 * sigma)
+                d = np.array([box_min(field, spec, ilo[j], ihi[j]) for j in range(n)])
+                d[members] = 0.0
+            else:
+                eu = np.linalg.norm(self.xy[:, None, :] - self.xy[None, members, :], axis=2)
+                d = np.where(self.visible[:, members], eu, np.inf).min(axis=1)
+            score[:, r] = np.maximum(score[:, r], w * np.exp(-0.5 * (d / sigma) ** 2))
+        return score
 
     # -- walls ---------------------------------------------------------------------------------
     def _wall_mask(self) -> NDArray[np.bool_] | None:
@@ -128,6 +139,11 @@ class SceneContext:
             return vis
         spec = self.occupancy.spec
         ii, jj = np.triu_indices(n, k=1)
+        # Only near pairs matter ("next to"); farther pairs are left visible, unused.
+        near = self.gap[ii, jj] <= self.config.los_range
+        ii, jj = ii[near], jj[near]
+        if len(ii) == 0:
+            return vis
         steps = max(2, int(np.ceil(float(np.max(np.linalg.norm(self.xy[ii] - self.xy[jj], axis=1))) / spec.resolution)))
         t = np.linspace(0.0, 1.0, steps)[None, :, None]
         chunk = max(1, 2_000_000 // steps)  # bound the (pairs, steps, 2) temporary
@@ -145,17 +161,9 @@ class SceneContext:
 
     # -- rooms ---------------------------------------------------------------------------------
     def room_scores(self, i: int) -> dict[str, float]:
-        """Per room type, the strongest cue: max over cue objects of weight * exp(-d^2 / 2 sigma^2)
-        with d the walking distance (the nearest stove says "kitchen"; ten armchairs do not add up)."""
-        scores: dict[str, float] = {}
-        for room, cues in ROOM_CUES.items():
-            s = 0.0
-            for k, dist in self.cue_distance.items():
-                w = cues.get(self.labels[k], 0.0)
-                if w > 0.0 and np.isfinite(dist[i]):
-                    s = max(s, w * float(np.exp(-0.5 * (dist[i] / self.config.room_sigma) ** 2)))
-            scores[room] = s
-        return scores
+        """Per room type, the strongest cue (the nearest stove says "kitchen"; ten armchairs do
+        not add up)."""
+        return {room: float(v) for room, v in zip(ROOM_CUES, self.room_score[i], strict=True)}
 
     def _room(self, i: int) -> str | None:
         scores = self.room_scores(i)

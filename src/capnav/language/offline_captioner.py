@@ -83,15 +83,14 @@ def footprint_shape(obj: MapObject, cfg: OfflineCaptionConfig) -> str | None:
     if area < 0.02:
         return None
     # Occupied share of the hull, both counted on the same grid (cells whose centre is inside).
-    from scipy.spatial import Delaunay
-
     res = max(0.04, np.sqrt(area / 400.0))
     origin = xy.min(0)
     cells = np.unique(np.floor((xy - origin) / res).astype(np.int64), axis=0)
     span = np.floor((xy.max(0) - origin) / res).astype(np.int64) + 1
     gx, gy = np.meshgrid(np.arange(span[0]), np.arange(span[1]), indexing="ij")
     centres = origin + (np.stack([gx.ravel(), gy.ravel()], 1) + 0.5) * res
-    in_hull = int((Delaunay(xy[hull.vertices]).find_simplex(centres) >= 0).sum())
+    eq = hull.equations  # inside: n . p + d <= 0 for every facet
+    in_hull = int(np.all(centres @ eq[:, :2].T + eq[:, 2] <= 1e-9, axis=1).sum())
     occ = len(cells) / max(in_hull, 1)
     centered = xy - xy.mean(0)
     ev = np.linalg.eigvalsh(np.cov(centered.T))

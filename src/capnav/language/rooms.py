@@ -89,14 +89,20 @@ def _dijkstra(domain: NDArray[np.bool_], seeds: NDArray[np.int64], limit: float)
     return dist
 
 
-def geodesic_from_box(domain: NDArray[np.bool_], spec: GridSpec, lo: NDArray[np.floating],
-                      hi: NDArray[np.floating], limit_m: float = 12.0) -> NDArray[np.float64]:
-    """Metres from an object's box to every cell through ``domain`` (inf where unreachable)."""
-    r0, c0, r1, c1 = box_cells(spec, lo, hi)
-    if r1 < r0 or c1 < c0:
+def geodesic_from_boxes(domain: NDArray[np.bool_], spec: GridSpec, los: NDArray[np.floating],
+                        his: NDArray[np.floating], limit_m: float = 12.0) -> NDArray[np.float64]:
+    """Metres from the nearest of several boxes to every cell through ``domain`` (inf where
+    unreachable or beyond ``limit_m``): one multi-source Dijkstra."""
+    seeds_list = []
+    for lo, hi in zip(np.atleast_2d(los), np.atleast_2d(his), strict=True):
+        r0, c0, r1, c1 = box_cells(spec, lo, hi)
+        if r1 < r0 or c1 < c0:
+            continue
+        rr, cc = np.mgrid[r0:r1 + 1, c0:c1 + 1]
+        seeds_list.append(np.stack([rr.ravel(), cc.ravel()], axis=1))
+    if not seeds_list:
         return np.full(domain.shape, np.inf)
-    rr, cc = np.mgrid[r0:r1 + 1, c0:c1 + 1]
-    seeds = np.stack([rr.ravel(), cc.ravel()], axis=1).astype(np.int64)
+    seeds = np.concatenate(seeds_list).astype(np.int64)
     seeds = seeds[domain[seeds[:, 0], seeds[:, 1]]]
     if len(seeds) == 0:
         return np.full(domain.shape, np.inf)
