@@ -8,6 +8,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.core.atomic import atomic_path
+from capnav.core.frame import Frame
 from capnav.core.grid import FREE, OccupancyGrid
 from capnav.sim.manifest import SceneManifest
 
@@ -35,10 +36,12 @@ def draw_scene(manifest: SceneManifest, path: str | Path, navigable: OccupancyGr
         ax.text(cx, poly[:, 1].max() - 0.25, f"{room.name} ({room.id})", ha="center", va="top", fontsize=8,
                 color="#555555", style="italic")
     if navigable is not None:
+        from matplotlib.colors import ListedColormap
+
         free = np.ma.masked_where(navigable.cells != FREE, np.ones(navigable.cells.shape))
         s = navigable.spec
         ax.imshow(free, origin="lower", extent=(s.x0, s.x0 + s.cols * s.resolution, s.y0, s.y0 + s.rows * s.resolution),
-                  cmap="Greens", vmin=0, vmax=2, alpha=0.3, interpolation="nearest")
+                  cmap=ListedColormap(["#6cc46c"]), alpha=0.35, interpolation="nearest", zorder=1.5)
     for room in manifest.rooms:  # walls
         poly = np.asarray(room.polygon + room.polygon[:1])
         ax.plot(poly[:, 0], poly[:, 1], color="#333333", lw=2.5, solid_capstyle="butt")
@@ -67,6 +70,43 @@ def draw_scene(manifest: SceneManifest, path: str | Path, navigable: OccupancyGr
     with atomic_path(out, suffix=".png") as tmp:
         fig.savefig(tmp, dpi=dpi, format="png")
     plt.close(fig)
+    return out
+
+
+def _ids_to_rgb(ids: NDArray[np.integer]) -> NDArray[np.uint8]:
+    """Distinct stable colours per id (0 = black)."""
+    ids = np.asarray(ids, dtype=np.int64)
+    rgb = np.stack([(ids * 97) % 200 + 55, (ids * 57) % 200 + 55, (ids * 151) % 200 + 55], axis=-1)
+    rgb[ids == 0] = 0
+    return rgb.astype(np.uint8)
+
+
+def frame_grid(frames: list[Frame], path: str | Path, cols: int = 4, truth: bool = False,
+               max_depth: float = 6.0) -> Path:
+    """Save frames side by side (PNG). With ``truth`` each row is rgb | depth | instance | category."""
+    from PIL import Image
+
+    tiles: list[NDArray[np.uint8]] = []
+    for f in frames:
+        if not truth:
+            tiles.append(f.rgb)
+            continue
+        d = np.clip(np.nan_to_num(f.depth) / max_depth, 0, 1)
+        depth = (np.stack([d, d, d], -1) * 255).astype(np.uint8)
+        depth[f.depth <= 0] = (255, 0, 255)
+        inst = _ids_to_rgb(f.gt_instance if f.gt_instance is not None else np.zeros(f.shape, int))
+        cat = _ids_to_rgb(f.gt_category if f.gt_category is not None else np.zeros(f.shape, int))
+        tiles += [f.rgb, depth, inst, cat]
+    cols = 4 if truth else cols
+    h, w = tiles[0].shape[:2]
+    rows = (len(tiles) + cols - 1) // cols
+    canvas = np.full((rows * (h + 2), cols * (w + 2), 3), 255, dtype=np.uint8)
+    for k, t in enumerate(tiles):
+        r, c = divmod(k, cols)
+        canvas[r * (h + 2):r * (h + 2) + h, c * (w + 2):c * (w + 2) + w] = t
+    out = Path(path)
+    with atomic_path(out, suffix=".png") as tmp:
+        Image.fromarray(canvas).save(tmp, format="PNG", optimize=True)
     return out
 
 
