@@ -112,3 +112,22 @@ def test_merge_duplicates_unit() -> None:
     objs = mem.export()
     assert [o.id for o in objs] == [1, 2, 3, 4]  # renumbered densely
     assert sum(o.label == "bed" for o in objs) == 1
+
+
+def test_recheck_moves_a_neighbours_detection_to_its_own_object() -> None:
+    from capnav.mapping import ObjectMemory, Observation, Track
+
+    rng = np.random.default_rng(1)
+    chair = rng.uniform(0, 0.45, (300, 3))
+    mem = ObjectMemory()
+    a = _feed(mem, 1, chair, range(0, 3))
+    b = _feed(mem, 2, chair + np.array([0.0, 0.8, 0.0]), range(3, 6))
+    t = Track(1, chair.mean(0), np.zeros(3), np.zeros(4), np.array([1.0, 0.0], np.float32), 3, "chair",
+              hits=4, object_id=a)
+    mem.objects[a].track_ids = [1]
+    obs = Observation(9, (0, 0, 10, 10), 100, 0.9, "chair", 2.0, False, 1.0)
+    oid = mem.observe(t, _det(chair + np.array([0.0, 0.8, 0.0])), obs, 9, h_min=2, busy=set())
+    assert oid == b and t.object_id == b and mem.relinks == 1
+    assert 9 not in mem.objects[a].frames and 9 in mem.objects[b].frames
+    # the next frame sees chair A again: consistent with b? no -> back to a
+    assert mem.observe(t, _det(chair), obs, 10, h_min=2, busy=set()) == a

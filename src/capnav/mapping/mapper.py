@@ -148,6 +148,7 @@ class Mapper:
             "detections_without_depth": self.lift_skips,
             "tracks": self.tracker._next_id - 1,
             "merged_duplicates": merged,
+            "relinked_detections": self.memory.relinks,
             "detector": self.detector.id,
             "encoder": self.encoder.id,
             "text_space": self.encoder.text_space,

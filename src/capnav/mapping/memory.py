@@ -31,7 +31,13 @@ class MemoryConfig:
     ``min_overlap`` of its points lie within ``overlap_radius`` of the other's points, or
     ``min_inside`` of them inside the other's box grown by ``overlap_radius``, and labels are
     compatible (equal, in one confusion group, or descriptor cosine >= ``min_cos``). Objects seen
-    together in more than ``max_covisible`` frames are distinct and never merged."""
+    together in more than ``max_covisible`` frames are distinct and never merged.
+
+    ``recheck``: eq. 12 can hand a track the detection of a same-class neighbour when the right
+    object is missed in that frame (0.8 m apart costs 0.68 < tau). A detection of a linked track
+    whose points lie outside the object's box grown by ``recheck_margin`` (fraction inside below
+    ``recheck_inside``) and almost nowhere near its points is re-linked by overlap, as on
+    confirmation, instead of corrupting the object."""
 
     point_voxel: float = 0.03
     max_points: int = 3000
@@ -43,6 +49,10 @@ class MemoryConfig:
     max_covisible: int = 1
     min_points: int = 10
     extent_percentile: float = 1.0
+    recheck: bool = True
+    recheck_margin: float = 0.15
+    recheck_inside: float = 0.2
+    recheck_min_points: int = 50
     seed: int = 0
 
     def __post_init__(self) -> None:
@@ -87,6 +97,7 @@ class ObjectMemory:
         self.objects: dict[int, _ObjectState] = {}
         self._pending: dict[int, list[tuple[LiftedDetection, Observation, int]]] = {}
         self._next_id = 1
+        self.relinks = 0  # detections moved to another object by the recheck
         self._rng = np.random.default_rng(self.config.seed)
 
     # ---- per frame ----------------------------------------------------------------------
@@ -106,8 +117,25 @@ class ObjectMemory:
             for d, o, f in self._pending.pop(track.id):
                 self._add(self.objects[oid], d, o, f)
             return oid
-        self._add(self.objects[track.object_id], det, obs, frame)
+        obj = self.objects[track.object_id]
+        if self.config.recheck and self._inconsistent(det.points, obj.points):
+            self.relinks += 1
+            obj.track_ids.remove(track.id)
+            track.object_id = self._link(track, [(det, obs, frame)], busy | {obj.id})
+            obj = self.objects[track.object_id]
+        self._add(obj, det, obs, frame)
         return track.object_id
+
+    def _inconsistent(self, pts: NDArray[np.float32], ref: NDArray[np.float32]) -> bool:
+        cfg = self.config
+        if len(ref) < cfg.recheck_min_points or len(pts) < 10:
+            return False
+        m = cfg.recheck_margin
+        lo, hi = ref.min(axis=0) - m, ref.max(axis=0) + m
+        if float(np.all((pts >= lo) & (pts <= hi), axis=1).mean()) >= cfg.recheck_inside:
+            return False
+        d, _ = cKDTree(ref).query(pts, distance_upper_bound=cfg.overlap_radius)
+        return float(np.isfinite(d).mean()) < 0.05
 
     def drop(self, track: Track) -> None:
         """A track died: unconfirmed detections are forgotten (false positives), objects stay."""
