@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -96,10 +97,13 @@ def main() -> None:
     ap.add_argument("--map-cache", type=Path, default=None, help="folder to keep the mapped apartments in")
     ap.add_argument("--max-frames", type=int, default=None, help="map from at most this many exploration frames")
     ap.add_argument("--depth-noise", action="store_true", help="Kinect-like depth noise in the mapped frames")
+    ap.add_argument("--unknown-cost", default=None, help="planner weight of unknown cells, or 'blocked'")
     args = ap.parse_args()
     from capnav.sim import DepthNoiseConfig, SimConfig, Simulator
 
     cfg = PlannerConfig()
+    if args.unknown_cost is not None:
+        cfg = replace(cfg, unknown_cost=None if args.unknown_cost == "blocked" else float(args.unknown_cost))
     if args.map_cache is not None:
         args.map_cache.mkdir(parents=True, exist_ok=True)
     print(f"# {cfg}")
