@@ -149,11 +149,27 @@ def _colors(words: list[str]) -> list[str]:
     return list(dict.fromkeys(out))
 
 
+#: Words whose typos would hide a predicate ("bseide" for "beside").
+_KEYWORDS = ["beside", "near", "next", "behind", "opposite", "front", "closest", "nearest", "farthest",
+             "furthest", "biggest", "largest", "smallest", "kitchen", "bedroom", "bathroom", "living", "office"]
+
+
+def _fix_keyword_typos(words: list[str]) -> list[str]:
+    out = []
+    for w in words:
+        if len(w) >= 5 and w not in _ENGLISH_HINTS and w not in _FORM_MAP:
+            near = difflib.get_close_matches(w, _KEYWORDS, n=1, cutoff=0.8)
+            if near:
+                w = near[0]
+        out.append(w)
+    return out
+
+
 def parse_instruction(text: str) -> ParsedQuery:
     t = validate_instruction(text)
     low = t.lower()
     norm = re.sub(r"[^a-z0-9\-' ]+", " ", low)
-    norm = " ".join(norm.replace("'s", "").split())
+    norm = " ".join(_fix_keyword_typos(norm.replace("'s", "").split()))
     q = ParsedQuery(text=t)
     # Room: "in the kitchen", "in the living room".
     head = norm

@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from capnav.core.categories import NAMES
 from capnav.core.errors import InputError
 from capnav.core.grid import GridSpec
-from capnav.language.context import SceneContext, canonical_label
+from capnav.language.context import ROOM_CUES, SceneContext, canonical_label
 from capnav.language.embedder import TextEmbedder
 from capnav.language.prompts import caption_name
 from capnav.mapping.cmap import CapNavMap
@@ -31,6 +31,7 @@ from capnav.retrieval.result import QueryResult
 from capnav.retrieval.verifier import AcceptFirst, Candidate, OfflineVerifier, Verifier
 
 _VOCAB = set(NAMES)
+_ROOMS = list(ROOM_CUES)
 
 
 def check_map_embeddings(objects: Sequence[MapObject], embedder: TextEmbedder) -> None:
@@ -115,7 +116,9 @@ class Retriever:
         mode = "semantic"
         if cfg.use_predicates and q.room is not None:
             in_room = np.array([self.scene.rooms[i] == q.room for i in pool], dtype=np.float64)
-            keys.append(-in_room)
+            # Inferred room first, then the strength of that room's cues (when none qualifies).
+            strength = self.scene.room_score[pool, _ROOMS.index(q.room)]
+            keys.append(-(in_room + np.round(strength, 2)))
             predicate, mode = "room", "predicate"
             notes.append(f"{int(in_room.sum())} of them appear to be in the {q.room} (inferred from nearby objects)")
         if cfg.use_predicates and q.relation is not None and q.anchor_category is not None:
