@@ -15,6 +15,8 @@ from capnav.retrieval import parse_instruction, validate_instruction
     ("In the kitchen, find the stool.", {"category": "stool", "room": "kitchen"}),
     ("the light blue bedside table", {"category": "nightstand", "colors": ["light blue"]}),
     ("take me to the chiar", {"category": "chair"}),  # a typo
+    ("the lamp bseide the stove", {"category": "lamp", "relation": "next to", "anchor_category": "stove"}),
+    ("the closest bedside table", {"category": "nightstand", "proximity": "closest"}),
     ("the plant in the yellow terracotta pot", {"category": "plant", "colors": ["yellow"]}),
     ("the gray armchair beside the lamp in the study",
      {"category": "armchair", "colors": ["grey"], "relation": "next to", "anchor_category": "lamp",

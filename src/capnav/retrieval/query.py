@@ -30,6 +30,7 @@ _EXTRA_FORMS = {"couches": "sofa", "sofas": "sofa", "chairs": "chair", "tables":
                 "stoves": "stove", "nightstands": "nightstand", "wardrobes": "wardrobe", "bathtubs": "bathtub",
                 "sofa bed": "sofa", "settees": "sofa", "coffee tables": "coffee table"}
 _FORM_MAP: dict[str, str] = {**{f: c for f, c in _FORMS}, **_EXTRA_FORMS}
+_FORM_WORDS = {w for f in _FORM_MAP for w in f.split()}
 _SINGLE_FORMS = sorted({f for f in _FORM_MAP if " " not in f and len(f) >= 4})
 
 _PROXIMITY = {"closest": "closest", "nearest": "closest", "near me": "closest", "closest to me": "closest",
@@ -157,7 +158,7 @@ _KEYWORDS = ["beside", "near", "next", "behind", "opposite", "front", "closest",
 def _fix_keyword_typos(words: list[str]) -> list[str]:
     out = []
     for w in words:
-        if len(w) >= 5 and w not in _ENGLISH_HINTS and w not in _FORM_MAP:
+        if len(w) >= 5 and w not in _ENGLISH_HINTS and w not in _FORM_WORDS:
             near = difflib.get_close_matches(w, _KEYWORDS, n=1, cutoff=0.8)
             if near:
                 w = near[0]
