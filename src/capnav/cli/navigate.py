@@ -18,6 +18,10 @@ def register(app: typer.Typer) -> None:
         start: Annotated[str | None, typer.Option(help="start pose X,Y[,YAW] (m, rad); default: seeded random")
                          ] = None,
         seed: Annotated[int, typer.Option(help="seed of the random start")] = 0,
+        episode: Annotated[Path | None, typer.Option(
+            help="episode file (capnav eval): scene and start pose from its episode --episode-id")] = None,
+        episode_id: Annotated[str | None, typer.Option(help="episode id in --episode (default: the first)")
+                              ] = None,
         out: Annotated[Path, typer.Option("--out", "-o", help="folder for navigate.png / navigate.json")] = Path(
             "runs/navigate"),
         occupancy: Annotated[str, typer.Option(help="plan on the 'mapped' occupancy or the simulator's 'truth'")
@@ -35,15 +39,25 @@ def register(app: typer.Typer) -> None:
         from capnav.core.errors import InputError
         from capnav.io.mapfile import load_map
         from capnav.language import create_embedder
-        from capnav.planning.instruction import OCCUPANCY_KINDS, parse_pose, random_start, run_instruction
+        from capnav.planning.instruction import (
+            OCCUPANCY_KINDS,
+            episode_start,
+            parse_pose,
+            random_start,
+            run_instruction,
+        )
         from capnav.retrieval import Retriever, create_verifier
         from capnav.sim import Simulator
 
         if occupancy not in OCCUPANCY_KINDS:  # fail before the slow loading below
             raise InputError(f"occupancy must be one of {', '.join(OCCUPANCY_KINDS)}, got {occupancy!r}")
         given = parse_pose(start) if start else None
+        ep_scene = None
+        if episode is not None:
+            ep_scene, ep_pose = episode_start(episode, episode_id)
+            given = given or ep_pose
         cmap = load_map(map_file)
-        scene_seed = scene if scene is not None else cmap.meta.get("scene_seed")
+        scene_seed = next((s for s in (scene, ep_scene, cmap.meta.get("scene_seed")) if s is not None), None)
         if scene_seed is None:
             raise InputError(f"{map_file} records no scene seed: pass --scene SEED")
         emb = create_embedder(embedder, **({"path": str(embedder_path)} if embedder_path else {}))

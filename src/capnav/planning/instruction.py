@@ -57,6 +57,21 @@ def parse_pose(text: str) -> tuple[float, float, float]:
     return vals[0], vals[1], vals[2] if len(vals) == 3 else 0.0
 
 
+def episode_start(path: str | Path, episode_id: str | None = None) -> tuple[int, tuple[float, float, float]]:
+    """Scene seed and start pose of an episode of an episode file (the first when no id is given)."""
+    from capnav.eval.episodes import EpisodeSet
+
+    eps = EpisodeSet.load(path).episodes
+    if not eps:
+        raise InputError(f"{path} holds no episodes")
+    match = [e for e in eps if episode_id is None or e.id == episode_id]
+    if not match:
+        ids = ", ".join(e.id for e in eps[:8])
+        raise InputError(f"no episode {episode_id!r} in {path} (first ids: {ids})")
+    e = match[0]
+    return e.scene_seed, (e.start.x, e.start.y, e.start.yaw)
+
+
 def random_start(sim: Simulator, seed: int) -> tuple[float, float, float]:
     """A seeded navigable start pose (when no episode or ``--start`` gives one)."""
     rng = np.random.default_rng([seed, 5])
