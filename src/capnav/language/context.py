@@ -2,11 +2,11 @@
 
 Room names are never observed, so a room is inferred from characteristic objects (fridge / stove /
 counter -> kitchen, bed -> bedroom, toilet / bathtub -> bathroom, sofa / TV -> living room,
-desk -> office). With an occupancy grid the map is segmented into rooms (``rooms.segment_rooms``)
-and each room's type is voted by the characteristic objects inside it; without one (or for an
-object outside every segmented room) the cues are weighted by distance and counted only when no
-wall lies between the two objects. Walls are occupied cells of the top-down grid that no
-object's box covers, so furniture standing between two objects does not hide them from each other.
+desk -> office). Each cue counts with its weight times a Gaussian of the walking distance: with an
+occupancy grid a geodesic through free space and furniture but not through walls
+(``rooms.geodesic_from_boxes``), without one the straight-line distance when no wall lies between.
+Walls are occupied cells of the top-down grid that no object's box covers. The strongest cue per
+room type wins (the nearest stove says "kitchen"; ten armchairs do not add up).
 Used by the offline captioner ("next to the bed", "in the kitchen") and by retrieval predicates.
 """
 
