@@ -70,6 +70,7 @@ def test_gemini_off_schema_falls_back_with_reason(obj, gemini_key):
     assert len(script.requests) == 3
     assert out.source.startswith("fallback:") and "UPPERCASE" in out.source
     assert out.text.startswith("SOFA, ")  # the offline caption
+    assert "test-key-123" not in out.source
 
 
 def test_gemini_needs_a_key_from_the_environment(monkeypatch):

@@ -122,8 +122,10 @@ class SceneContext:
     def _wall_mask(self) -> NDArray[np.bool_] | None:
         if self.occupancy is None:
             return None
+        from capnav.language.rooms import fill_gaps
+
         spec = self.occupancy.spec
-        wall = self.occupancy.cells == OCCUPIED
+        wall = fill_gaps(self.occupancy.cells) == OCCUPIED
         m = self.config.object_margin
         for lo, hi in zip(self.lo, self.hi, strict=True):
             r0, c0 = spec.to_cell(lo - m)
