@@ -124,3 +124,22 @@ def test_start_inside_an_obstacle_is_an_input_error(sim) -> None:
 
     with pytest.raises(InputError, match="inside an obstacle"):
         navigate_to(Stuck(), occ, np.asarray(sim.manifest.objects[1].footprint))
+
+
+def test_unreachable_object_stops_at_the_closest_cell_with_the_reason(sim) -> None:
+    occ = sim.obstacles()
+    inst = max(sim.manifest.objects, key=lambda o: o.size[0] * o.size[1])
+    fp = np.asarray(inst.footprint)
+    # The map claims a wall ring 1.2-1.4 m around the object: nothing within reach is reachable.
+    rr, cc = np.mgrid[0:occ.spec.rows, 0:occ.spec.cols]
+    d = footprint_distance(occ.spec.to_world(np.stack([rr.ravel(), cc.ravel()], axis=1)), fp).reshape(rr.shape)
+    cells = occ.cells.copy()
+    cells[(d > 1.2) & (d < 1.4)] = 1
+    walled = OccupancyGrid(occ.spec, cells)
+    free = sim.navigable().spec.to_world(np.argwhere((sim.navigable().cells == FREE) & (d > 2.0)))
+    x, y = free[len(free) // 2]
+    agent = sim.spawn_agent(float(x), float(y), 0.0)
+    res = navigate_to(agent, walled, fp)
+    assert not res.reached and res.goal is not None and not res.goal.reached_within_reach
+    assert "no reachable free cell within 1.00 m" in res.reason
+    assert 1.0 < res.distance_to_object < 2.0  # it went as close as the map allows
