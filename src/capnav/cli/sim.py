@@ -18,7 +18,8 @@ def register(app: typer.Typer) -> None:
         height: int = typer.Option(240, "--height"),
         hfov: float = typer.Option(90.0, "--hfov", help="horizontal field of view (degrees)"),
         rooms: int | None = typer.Option(None, "--rooms", help="number of rooms 3..7 (default: from the seed)"),
-        furniture: str = typer.Option("primitives", "--furniture", help="primitives | sh3d"),
+        furniture: str = typer.Option("primitives", "--furniture", help="primitives | sh3d (after `capnav assets`)"),
+        assets_dir: Path | None = typer.Option(None, "--assets-dir", help="mesh cache of `capnav assets --dir`"),
         depth_noise: bool = typer.Option(False, "--depth-noise", help="consumer RGB-D depth noise (seeded)"),
         overwrite: bool = typer.Option(False, "--overwrite", help="replace a non-empty output folder"),
     ) -> None:
@@ -29,5 +30,5 @@ def register(app: typer.Typer) -> None:
 
         summary = record_dataset(seed=seed, out=out, frames=frames, stride=stride, width=width, height=height,
                                  hfov=hfov, rooms=rooms, furniture=furniture, depth_noise=depth_noise,
-                                 overwrite=overwrite)
+                                 overwrite=overwrite, assets_dir=assets_dir)
         Console().print(summary, markup=False, highlight=False)

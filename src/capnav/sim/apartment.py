@@ -260,6 +260,16 @@ def generate_apartment(seed: int, cfg: SimConfig) -> Apartment:
     return Apartment(seed, cfg, plan, items, walls, faces, floors, wall_colors)
 
 
+def _model_id(o: SceneObject) -> str:
+    mesh_id = getattr(o.mesh, "id", None)
+    return f"sh3d:{mesh_id}" if mesh_id is not None else f"{o.source}:{o.category}/{o.model.variant}"
+
+
+def _shape(o: SceneObject) -> str:
+    name = getattr(o.mesh, "name", None)
+    return str(name).lower() if name is not None else o.model.variant
+
+
 def _manifest(apt: Apartment) -> SceneManifest:
     plan = apt.plan
     room_ids = [f"room{k}" for k in range(len(plan.rooms))]
@@ -268,11 +278,11 @@ def _manifest(apt: Apartment) -> SceneManifest:
         fp = o.footprint()
         objs.append(ObjectInstance(
             id=o.id, category=o.category, category_id=BY_NAME[o.category].id, color_name=o.color_name,
-            color_rgb=o.roles["main"], material=o.material, shape=o.model.variant,
+            color_rgb=o.roles["main"], material=o.material, shape=_shape(o),
             size=(o.model.size[0], o.model.size[1], o.model.size[2]),
             center=(o.x, o.y, o.model.size[2] / 2), yaw=float(o.yaw),
             footprint=[(float(x), float(y)) for x, y in fp], room=room_ids[o.room],
-            model=f"{o.source}:{o.category}/{o.model.variant}", license=o.license))
+            model=_model_id(o), license=o.license))
     rooms = [Room(id=room_ids[k], name=t, polygon=r.polygon()) for k, (r, t) in enumerate(
         zip(plan.rooms, plan.types, strict=True))]
     doors = [Door(rooms=(room_ids[d.rooms[0]], room_ids[d.rooms[1]]), center=d.center, width=d.width)

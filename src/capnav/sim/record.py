@@ -19,7 +19,7 @@ from capnav.sim.simulator import Simulator
 def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride: int = 1, width: int = 320,
                    height: int = 240, hfov: float = 90.0, rooms: int | None = None, furniture: str = "primitives",
                    depth_noise: bool = False, overwrite: bool = False, progress: bool = True,
-                   config: SimConfig | None = None) -> str:
+                   config: SimConfig | None = None, assets_dir: str | Path | None = None) -> str:
     """Build apartment ``seed``, render its exploration pass into ``out``; returns a one-line summary.
 
     Writes ``out/manifest.json`` (scene truth, for evaluation) and ``out/topdown.png`` beside the frames.
@@ -34,7 +34,7 @@ def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride
                   if config is not None else CameraConfig(width=width, height=height, hfov_deg=hfov),
                   layout=LayoutConfig(rooms=rooms) if rooms is not None else base.layout,
                   depth_noise=DepthNoiseConfig(enabled=True, seed=seed) if depth_noise else base.depth_noise,
-                  furniture=furniture)
+                  furniture=furniture, assets_dir=str(assets_dir) if assets_dir is not None else base.assets_dir)
     t0 = time.perf_counter()
     with Simulator.from_seed(seed, cfg) as sim:
         t_build = time.perf_counter() - t0

@@ -42,12 +42,12 @@ class Simulator:
 
     @classmethod
     def from_seed(cls, seed: int, config: SimConfig | None = None) -> Simulator:
-        config = config if config is not None else SimConfig()
-        if config.furniture != "primitives":
-            from capnav.sim.furniture import furnish
+        from capnav.sim.furniture import FURNITURE, furnish
 
-            return cls(furnish(generate_apartment(seed, config), config))
-        return cls(generate_apartment(seed, config))
+        config = config if config is not None else SimConfig()
+        if config.furniture not in FURNITURE:  # fail before the (slower) scene generation
+            FURNITURE.create(config.furniture)
+        return cls(furnish(generate_apartment(seed, config), config))
 
     # -- truth -----------------------------------------------------------------------------
     @property
