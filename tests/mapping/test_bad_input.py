@@ -112,3 +112,12 @@ def test_empty_and_malformed_detections(frames: list, embedder) -> None:  # type
     m3 = _mapper(embedder, detector=_Fixed([Detection((10, 10, 20, 20), 3, "chair", 0.9, hole)]))
     m3.integrate(dataclasses.replace(f, depth=np.where(hole, 0.0, f.depth).astype(np.float32)))
     assert m3.lift_skips == 1 and m3.finish().meta["detections_without_depth"] == 1
+
+
+def test_pose_jumps_are_reported(frames: list, embedder) -> None:  # type: ignore[no-untyped-def]
+    m = _mapper(embedder)
+    m.integrate(frames[0])
+    far = frames[1].T_wc.copy()
+    far[:3, 3] += [2.0, 0.0, 0.0]
+    m.integrate(dataclasses.replace(frames[1], T_wc=far))
+    assert m.finish().meta["pose_jumps"] == [{"frame": 1, "metres": pytest.approx(2.0, abs=0.2)}]

@@ -10,6 +10,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from capnav.core.errors import FrameError, InputError
 from capnav.core.frame import Frame
@@ -32,7 +33,9 @@ class MapperConfig:
 
     ``on_bad_frame``: "skip" records the frame and the reason in ``meta["frames_skipped"]`` and
     goes on (one bad frame in 10,000 should not lose a map); "raise" stops with ``FrameError``.
-    Frames with more than ``max_invalid_depth`` invalid depth pixels count as bad.
+    Frames with more than ``max_invalid_depth`` invalid depth pixels count as bad. A camera that
+    moves more than ``max_pose_jump`` between consecutive used frames is listed in
+    ``meta["pose_jumps"]`` (a wrong pose convention or a dropped stretch of frames shows up there).
     """
 
     voxel: VoxelConfig = field(default_factory=VoxelConfig)
@@ -42,6 +45,7 @@ class MapperConfig:
     lift: LiftConfig = field(default_factory=LiftConfig)
     on_bad_frame: Literal["skip", "raise"] = "skip"
     max_invalid_depth: float = 0.98
+    max_pose_jump: float = 1.5  # m between consecutive frames; larger jumps are reported, not skipped
 
     def __post_init__(self) -> None:
         if self.on_bad_frame not in ("skip", "raise"):
@@ -72,6 +76,8 @@ class Mapper:
         self.frames_used: list[int] = []
         self.skipped: list[dict[str, Any]] = []
         self.lift_skips = 0
+        self.pose_jumps: list[dict[str, Any]] = []
+        self._last_eye: NDArray[np.float64] | None = None
         self.seconds = 0.0
 
     def _bad(self, err: FrameError) -> bool:
@@ -103,6 +109,13 @@ class Mapper:
                 raise FrameError(frame.index, "encoder returned non-finite features")
         except FrameError as e:
             return self._bad(e)
+        eye = np.asarray(frame.T_wc, dtype=np.float64)[:3, 3]
+        if self._last_eye is not None:
+            jump = float(np.linalg.norm(eye - self._last_eye))
+            if jump > self.config.max_pose_jump:
+                log.warning("frame %s: camera moved %.2f m since the previous frame", frame.index, jump)
+                self.pose_jumps.append({"frame": frame.index, "metres": round(jump, 3)})
+        self._last_eye = eye
         vc = self.config.voxel
         proj = self.voxels.project(table) if self.voxels.projection is not None else table
         self.voxels.integrate_frame(frame.depth, frame.rgb, frame.K, frame.T_wc, grid, proj, vc.sigma,
@@ -145,6 +158,7 @@ class Mapper:
             "first_frame": self.frames_used[0] if self.frames_used else None,
             "last_frame": self.frames_used[-1] if self.frames_used else None,
             "frames_skipped": list(self.skipped),
+            "pose_jumps": list(self.pose_jumps),
             "detections_without_depth": self.lift_skips,
             "tracks": self.tracker._next_id - 1,
             "merged_duplicates": merged,
