@@ -48,6 +48,7 @@ class ViewConfig:
     crop_margin: float = 0.12
     box_color: tuple[int, int, int] = (255, 0, 0)
     box_width: int = 2
+    frame_cache_mb: float = 512.0  # RGB kept between scoring and rendering instead of reading twice
 
 
 def _metadata_score(ob: Observation, width: int, height: int, cfg: ViewConfig) -> float:
@@ -93,16 +94,16 @@ def _png(img: NDArray[np.uint8]) -> bytes:
     return buf.getvalue()
 
 
-def render_view(frame: Frame, box: Sequence[float], cfg: ViewConfig) -> tuple[bytes, bytes]:
+def render_view(rgb: NDArray[np.uint8], box: Sequence[float], cfg: ViewConfig) -> tuple[bytes, bytes]:
     """(full frame with the box drawn, tight crop) as PNG bytes."""
     from PIL import Image, ImageDraw
 
-    img = Image.fromarray(frame.rgb)
+    img = Image.fromarray(rgb)
     ImageDraw.Draw(img).rectangle([float(box[0]), float(box[1]), float(box[2]), float(box[3])],
                                   outline=cfg.box_color, width=cfg.box_width)
-    h, w = frame.rgb.shape[:2]
+    h, w = rgb.shape[:2]
     x0, y0, x1, y1 = _crop_box(box, w, h, cfg.crop_margin)
-    return _png(np.asarray(img)), _png(np.ascontiguousarray(frame.rgb[y0:y1, x0:x1]))
+    return _png(np.asarray(img)), _png(np.ascontiguousarray(rgb[y0:y1, x0:x1]))
 
 
 @dataclass
@@ -122,7 +123,8 @@ def _gain(c: _Candidate, picked: list[_Candidate], cfg: ViewConfig) -> float:
 
 def select_views_all(objects: Sequence[MapObject], reader: FrameReader, config: ViewConfig | None = None,
                      progress: bool = False) -> dict[int, list[ObjectView]]:
-    """Choose and render views for many objects, reading each needed frame at most twice."""
+    """Choose and render views for many objects, reading each needed frame once (twice beyond
+    the ``frame_cache_mb`` budget)."""
     cfg = config or ViewConfig()
     n_frames = len(reader)
     by_frame: dict[int, list[_Candidate]] = defaultdict(list)
@@ -143,8 +145,13 @@ def select_views_all(objects: Sequence[MapObject], reader: FrameReader, config: 
         for c in cands:
             by_frame[c.ob.frame_index].append(c)
     # Pass 1: pixel-based terms for the candidates.
+    rgb_cache: dict[int, NDArray[np.uint8]] = {}
+    budget = cfg.frame_cache_mb * 1e6
     for fi in track(sorted(by_frame), "scoring views", enabled=progress):
         frame = reader.frame(fi)
+        if budget >= frame.rgb.nbytes:
+            rgb_cache[fi] = frame.rgb
+            budget -= frame.rgb.nbytes
         gray = frame.rgb.astype(np.float32).mean(axis=2) / 255.0
         hh, ww = gray.shape
         for c in by_frame[fi]:
@@ -169,9 +176,9 @@ def select_views_all(objects: Sequence[MapObject], reader: FrameReader, config: 
             render[c.ob.frame_index].append(c)
     views: dict[int, dict[int, ObjectView]] = defaultdict(dict)
     for fi in track(sorted(render), "rendering views", enabled=progress):
-        frame = reader.frame(fi)
+        rgb = rgb_cache[fi] if fi in rgb_cache else reader.frame(fi).rgb
         for c in render[fi]:
-            full, crop = render_view(frame, c.ob.box, cfg)
+            full, crop = render_view(rgb, c.ob.box, cfg)
             views[c.obj][id(c)] = ObjectView(fi, tuple(float(b) for b in c.ob.box), round(c.score, 6), full, crop)  # type: ignore[arg-type]
     return {objects[k].id: [views[k][id(c)] for c in chosen[k]] for k in per_obj}
 
