@@ -149,7 +149,7 @@ class FrontierExplorer:
         field, _ = cost_field(cm.weights, start)
         known = passable & (grid.cells == FREE)
         dist = np.where(known, field * grid.spec.resolution, np.inf)
-        out = find_frontiers(grid, known, dist, self.config.min_frontier_cells, self.config.frontier_tile)
+        out = find_frontiers(grid, dist, self.config.min_frontier_cells, self.config.frontier_tile)
         r2 = self.config.visited_radius**2
         return [f for f in out if math.isfinite(f.path_distance)
                 and not any((f.target_xy[0] - s[0]) ** 2 + (f.target_xy[1] - s[1]) ** 2 < r2 for s in self.spent)]

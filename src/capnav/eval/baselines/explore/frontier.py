@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
 
-from capnav.core.grid import FREE, UNKNOWN, GridSpec, OccupancyGrid
+from capnav.core.grid import FREE, UNKNOWN, OccupancyGrid
 
 _EIGHT = np.ones((3, 3), bool)
 
@@ -29,9 +29,11 @@ class Frontier:
     path_distance: float  # metres from the agent through traversable cells (inf if unreachable)
 
 
-def find_frontiers(grid: OccupancyGrid, passable: NDArray[np.bool_], dist: NDArray[np.float64],
-                   min_cells: int = 4, max_extent: float = 1.5) -> list[Frontier]:
+def find_frontiers(grid: OccupancyGrid, dist: NDArray[np.float64], min_cells: int = 4,
+                   max_extent: float = 1.5) -> list[Frontier]:
     """Frontier clusters of ``grid`` with at least ``min_cells`` cells, nearest (by path) first.
+
+    ``dist`` is the path cost (m) from the agent to every cell, inf where the agent cannot stand.
 
     Connected frontier cells are cut into tiles of ``max_extent`` metres: the free space seen
     from one spot is ringed by a single long frontier, whose centroid would be useless as a goal.
@@ -59,7 +61,7 @@ def find_frontiers(grid: OccupancyGrid, passable: NDArray[np.bool_], dist: NDArr
     # Reachable cells of a cluster: the frontier cell itself, or a passable cell right next to it
     # (frontier cells hug walls, where the inflated obstacle makes them impassable).
     d_cell = dist[rr, cc]
-    reach_d = _nearest_reachable(passable, dist, rr, cc)
+    reach_d = _nearest_reachable(dist, rr, cc)
     spec = grid.spec
     out: list[Frontier] = []
     for k in range(n):
@@ -86,12 +88,12 @@ def find_frontiers(grid: OccupancyGrid, passable: NDArray[np.bool_], dist: NDArr
     return out
 
 
-def _nearest_reachable(passable: NDArray[np.bool_], dist: NDArray[np.float64], rr: NDArray[np.intp],
+def _nearest_reachable(dist: NDArray[np.float64], rr: NDArray[np.intp],
                        cc: NDArray[np.intp], reach: int = 6) -> tuple[NDArray[np.float64], NDArray[np.intp],
                                                                       NDArray[np.intp]]:
     """For each cell (rr, cc): the reachable cell within ``reach`` cells (Chebyshev) of smallest path
     distance, as (distance, row, col). Vectorised over the window offsets."""
-    rows, cols = passable.shape
+    rows, cols = dist.shape
     best = np.full(len(rr), np.inf)
     br = rr.astype(np.intp).copy()
     bc = cc.astype(np.intp).copy()
@@ -106,8 +108,3 @@ def _nearest_reachable(passable: NDArray[np.bool_], dist: NDArray[np.float64], r
             br[better] = r2[better]
             bc[better] = c2[better]
     return best, br, bc
-
-
-def cell_of(spec: GridSpec, xy: NDArray[np.floating] | tuple[float, float]) -> tuple[int, int]:
-    rc = spec.to_cell(np.asarray(xy, dtype=np.float64))
-    return int(rc[0]), int(rc[1])
