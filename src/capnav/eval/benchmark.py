@@ -5,7 +5,8 @@ Run folder layout::
     OUT/config.json                 the run's settings, seed, version, commit, command
     OUT/episodes/<protocol>.json    the episode files (rerun exactly with --episodes OUT/episodes)
     OUT/scenes/<seed>/map.capnav    the apartment's prior map (built once, shared by all methods)
-    OUT/scenes/<seed>/result.json   that apartment's records and timings
+    OUT/scenes/<seed>/result.json   that apartment's records and timings (reused by a rerun with the
+                                    same settings, so an interrupted run resumes where it stopped)
     OUT/logs/<method>/<protocol>/<episode>.json   per-episode logs with trajectories
     OUT/pictures/*.png              failure cases
     OUT/records.jsonl               every scored subgoal (no trajectories)
@@ -97,8 +98,6 @@ def run_benchmark(config: EvalConfig, out: str | Path, workers: int = 1, ray_add
     tasks = [SceneTask(config, s, str(out), {p: [e.model_dump() for e in es.for_scene(s)] for p, es in given.items()}
                        or None) for s in scene_seeds]
     results = run_tasks(run_scene, tasks, workers=workers, ray_address=ray_address, progress=progress)
-    for res in results:
-        write_json(out / "scenes" / str(res["scene_seed"]) / "result.json", res)
 
     if not given:  # save the generated episodes so that anyone can rerun exactly
         for p in config.protocols:

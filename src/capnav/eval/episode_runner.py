@@ -62,17 +62,31 @@ def run_episode(method: NavMethod, ctx: SceneContext, episode: Episode, truth: S
     """Spawn the agent at the episode's start, run the subgoals in order, score each."""
     s = episode.start
     agent = ctx.sim.spawn_agent(s.x, s.y, s.yaw)
-    method.start_episode(ctx, agent)
+    broken = ""
+    try:
+        method.start_episode(ctx, agent)
+    except CapNavError as e:  # e.g. a map without objects: every subgoal fails, the run goes on
+        broken = f"could not start: {type(e).__name__}: {e}"
+    except Exception as e:  # a bug in a method must not end an hour-long run; it is counted as a crash
+        broken = f"CRASH in start_episode: {type(e).__name__}: {e}"
     records: list[SubgoalRecord] = []
     for i, goal in enumerate(episode.subgoals):
         start_xy = _xy(agent)
         odo0, traj0 = _odometry(agent), len(_trajectory(agent))
         t0 = time.perf_counter()
-        try:
-            out = method.run_subgoal(goal.text, agent)
-        except CapNavError as e:  # an expected failure (unreachable goal, nothing found): the agent stays put
-            out = SubgoalOutcome(found=False, reason=f"{type(e).__name__}: {e}",
-                                 query_time_s=time.perf_counter() - t0)
+        error = ""
+        if broken:
+            out = SubgoalOutcome(found=False, reason=broken)
+            error = broken if broken.startswith("CRASH") else ""
+        else:
+            try:
+                out = method.run_subgoal(goal.text, agent)
+            except CapNavError as e:  # an expected failure (unreachable goal, bad map): the agent stays put
+                out = SubgoalOutcome(found=False, reason=f"{type(e).__name__}: {e}",
+                                     query_time_s=time.perf_counter() - t0)
+            except Exception as e:  # a bug: scored as a failure, counted and reported as a crash
+                error = f"CRASH: {type(e).__name__}: {e}"
+                out = SubgoalOutcome(found=False, reason=error, query_time_s=time.perf_counter() - t0)
         stop_xy = _xy(agent)
         footprints = [truth.footprints[t] for t in goal.target_ids]
         dist = distance_to_instances(stop_xy, footprints)
@@ -88,7 +102,7 @@ def run_episode(method: NavMethod, ctx: SceneContext, episode: Episode, truth: S
             query_time_s=float(out.query_time_s), steps=int(out.steps), reason=out.reason,
             target_xy=None if out.target_xy is None else (float(out.target_xy[0]), float(out.target_xy[1])),
             chosen_object=out.chosen_object, explanation=out.explanation,
-            trajectory=[(round(x, 3), round(y, 3)) for x, y in traj]))
+            trajectory=[(round(x, 3), round(y, 3)) for x, y in traj], error=error))
     return records
 
 

@@ -52,6 +52,7 @@ class SubgoalRecord:
     chosen_object: int | None = None
     explanation: str = ""
     trajectory: list[tuple[float, float]] = field(default_factory=list)
+    error: str = ""  # non-empty when the method crashed on this subgoal (scored as a failure)
 
     @property
     def spl(self) -> float:
@@ -105,6 +106,7 @@ class Summary:
     query_time_mean_s: float
     query_time_p50_s: float
     found_rate: float
+    crashes: int = 0  # subgoals on which the method raised an unexpected exception
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -165,6 +167,7 @@ def summarize(records: Sequence[SubgoalRecord]) -> Summary:
         query_time_mean_s=float(times.mean()),
         query_time_p50_s=float(np.median(times)),
         found_rate=float(np.mean([r.found for r in records])),
+        crashes=sum(1 for r in records if r.error),
     )
 
 

@@ -63,12 +63,12 @@ def table2(summaries: Sequence[Summary]) -> list[str]:
 
 def details(summaries: Sequence[Summary]) -> list[str]:
     lines = ["| Method | Protocol | Episodes | Subgoals | Indep. | SPL | Retrieval top-1 | Goal claimed "
-             "| Path / subgoal (m) | Query time mean / p50 (ms) |",
-             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "| Path / subgoal (m) | Query time mean / p50 (ms) | Crashes |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for s in _sorted(summaries):
         lines.append(f"| {s.method} | {s.protocol} | {s.episodes} | {s.subgoals} | {_pct(s.independent)} "
                      f"| {_pct(s.spl)} | {_pct(s.retrieval_top1)} | {_pct(s.found_rate)} | {s.path_length:.2f} "
-                     f"| {1e3 * s.query_time_mean_s:.1f} / {1e3 * s.query_time_p50_s:.1f} |")
+                     f"| {1e3 * s.query_time_mean_s:.1f} / {1e3 * s.query_time_p50_s:.1f} | {s.crashes} |")
     return lines
 
 

@@ -8,8 +8,10 @@ independent and deterministic, so a run's numbers do not depend on how tasks wer
 
 from __future__ import annotations
 
+import hashlib
+import json
 import time
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +24,8 @@ from capnav.eval.generate import EpisodeConfig, description_episodes, label_epis
 from capnav.eval.method import SceneContext, create_method
 from capnav.eval.metrics import SubgoalRecord
 from capnav.eval.pipeline import PipelineConfig, SceneAssets, open_scene
+
+RESULT_FILE = "result.json"
 
 #: Every method of the benchmark, in report order (exploration baselines join when registered).
 DEFAULT_METHODS: tuple[str, ...] = ("random-object", "category-only", "vlmaps", "capnav-no-verify",
@@ -70,16 +74,38 @@ def generate_scene_episodes(assets: SceneAssets, config: EvalConfig, protocol: s
     return description_episodes(assets.truth, describe, rng, config.episode_config())
 
 
+def task_key(task: SceneTask) -> str:
+    """Identity of a task's results: settings, apartment and given episodes (not the progress flag)."""
+    blob = json.dumps({"config": asdict(task.config), "scene": task.scene_seed, "episodes": task.episodes},
+                      sort_keys=True, default=str)
+    return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+
 def run_scene(task: SceneTask) -> dict[str, Any]:
-    """Run one apartment; returns {"scene_seed", "episodes", "records", "timings", "failures", "map"}."""
+    """Run one apartment; returns {"scene_seed", "episodes", "records", "timings", "failures", "map"}.
+
+    The result is saved in the run folder as soon as the apartment is done; a rerun of the same
+    task (same settings) returns it instead of recomputing, so an interrupted run resumes."""
     cfg = task.config
     out = Path(task.out)
     folder = out / "scenes" / str(task.scene_seed)
+    key = task_key(task)
+    saved = folder / RESULT_FILE
+    if saved.is_file():
+        try:
+            old = json.loads(saved.read_text())
+            if old.get("task_key") == key:
+                return dict(old)
+        except (OSError, json.JSONDecodeError):
+            pass  # unreadable: recompute
     assets = open_scene(task.scene_seed, cfg.seed, cfg.pipeline, folder)
     try:
-        return _run(task, cfg, out, assets)
+        res = _run(task, cfg, out, assets)
     finally:
         assets.sim.close()
+    res["task_key"] = key
+    write_json(saved, res)
+    return res
 
 
 def _run(task: SceneTask, cfg: EvalConfig, out: Path, assets: SceneAssets) -> dict[str, Any]:
