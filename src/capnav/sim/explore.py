@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,12 +27,13 @@ class ExploreConfig:
     seed: int = 0
     turn_deg: float = 30.0  # rotation step when looking around at a spot
     look_pitches_deg: tuple[float, float] = (8.0, 30.0)  # alternated while looking around
-    spot_area: float = 12.0  # one look-around spot per this many m² of room (1..3 per room)
+    spot_area: float = 12.0  # one look-around spot per this many m² of room (1..4 per room)
     view_distances: tuple[float, ...] = (1.3, 2.3)  # one view of every object per distance
     travel_step: float = 0.5  # a frame every this many metres while walking
     travel_pitch_deg: float = 12.0
     stride: int = 1  # keep every stride-th frame
     max_frames: int | None = None  # subsample uniformly to at most this many frames
+    min_frames: int = 200  # small flats get more viewpoints (extra distances and spots) up to this
 
     def __post_init__(self) -> None:
         if self.stride < 1:
@@ -45,6 +46,21 @@ class ExploreConfig:
 
 def plan_exploration(sim: Simulator, cfg: ExploreConfig) -> list[NDArray[np.float64]]:
     """Camera poses (T_wc) of the whole pass, in order; deterministic given the scene and ``cfg.seed``."""
+    poses = _plan(sim, cfg)
+    extra = (1.8, 3.0, 0.9)
+    for k in range(len(extra)):  # small flats: look from more distances and spots
+        if len(poses) >= cfg.min_frames:
+            break
+        dense = replace(cfg, view_distances=cfg.view_distances + extra[:k + 1], spot_area=cfg.spot_area / (k + 2))
+        poses = _plan(sim, dense)
+    poses = poses[::cfg.stride]
+    if cfg.max_frames is not None and len(poses) > cfg.max_frames:
+        keep = np.round(np.linspace(0, len(poses) - 1, cfg.max_frames)).astype(int)
+        poses = [poses[i] for i in keep]
+    return poses
+
+
+def _plan(sim: Simulator, cfg: ExploreConfig) -> list[NDArray[np.float64]]:
     rng = np.random.default_rng([cfg.seed, sim.seed, 7])
     grid = sim.nav_grid()
     pts = grid.free_points()
@@ -60,7 +76,7 @@ def plan_exploration(sim: Simulator, cfg: ExploreConfig) -> list[NDArray[np.floa
             continue
         # stops: (x, y, look) where look is None for a look-around, or the (x, y, z) to look at
         stops: list[tuple[float, float, tuple[float, float, float] | None]] = []
-        for s in _spread_points(inroom, grid, max(1, min(3, round(r.area / cfg.spot_area))), rng):
+        for s in _spread_points(inroom, grid, max(1, min(4, round(r.area / cfg.spot_area))), rng):
             stops.append((float(s[0]), float(s[1]), None))
         for o in (o for o in apt.objects if o.room == k):
             target = (o.x, o.y, min(o.model.size[2] * 0.6, cam_h))
@@ -95,10 +111,6 @@ def plan_exploration(sim: Simulator, cfg: ExploreConfig) -> list[NDArray[np.floa
                 yaw = math.atan2(dy, dx)
                 pitch = -math.atan2(dz, math.hypot(dx, dy))
                 poses.append(look_at_pose(eye, yaw, pitch))
-    poses = poses[::cfg.stride]
-    if cfg.max_frames is not None and len(poses) > cfg.max_frames:
-        keep = np.round(np.linspace(0, len(poses) - 1, cfg.max_frames)).astype(int)
-        poses = [poses[i] for i in keep]
     return poses
 
 
