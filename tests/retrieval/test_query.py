@@ -28,6 +28,15 @@ def test_parse(text, expect):
         assert q[k] == v, (k, q)
 
 
+@pytest.mark.parametrize(("text", "cat", "unknown"), [
+    ("the pool table", None, ["pool", "table"]), ("the grandfather clock", None, ["grandfather", "clock"]),
+    ("the second chair", "chair", []), ("the wooden table", "table", []), ("the yelow sofa", "sofa", []),
+])
+def test_compound_names_are_other_objects(text, cat, unknown):
+    q = parse_instruction(text)
+    assert q.category == cat and q.unknown_words == unknown
+
+
 def test_unknown_target_and_category_only():
     q = parse_instruction("find the piano")
     assert q.category is None and q.unknown_words == ["piano"] and q.target_phrase == "piano"

@@ -150,9 +150,13 @@ def _colors(words: list[str]) -> list[str]:
     return list(dict.fromkeys(out))
 
 
-#: Words whose typos would hide a predicate ("bseide" for "beside").
+#: Words whose typos would hide a predicate or attribute ("bseide" for "beside", "yelow" for "yellow").
 _KEYWORDS = ["beside", "near", "next", "behind", "opposite", "front", "closest", "nearest", "farthest",
-             "furthest", "biggest", "largest", "smallest", "kitchen", "bedroom", "bathroom", "living", "office"]
+             "furthest", "biggest", "largest", "smallest", "kitchen", "bedroom", "bathroom", "living", "office",
+             *sorted(w for w in LEXICON if " " not in w and len(w) >= 5)]
+_COMMON_ADJECTIVES = {"shaped", "l", "coloured", "colored", "color", "colour", "light", "dark", "first", "second",
+                      "third", "fourth", "last", "other", "left", "right", "main", "old", "new", "nice", "same",
+                      "only", "usual", "favourite", "favorite", "pretty", "modern", "classic", "comfy", "comfortable"}
 
 
 def _fix_keyword_typos(words: list[str]) -> list[str]:
@@ -164,6 +168,14 @@ def _fix_keyword_typos(words: list[str]) -> list[str]:
                 w = near[0]
         out.append(w)
     return out
+
+
+def _is_compound_modifier(word: str, known: set[str]) -> bool:
+    """A word before a category noun that is no colour, material, size, shape or filler word
+    (nor a typo of one) and no category word makes a different object ("pool table")."""
+    if word in known or word in _FORM_WORDS or word in _KEYWORDS or not word.isalpha() or len(word) < 3:
+        return False
+    return not difflib.get_close_matches(word, sorted(known | _FORM_WORDS), n=1, cutoff=0.75)
 
 
 def parse_instruction(text: str) -> ParsedQuery:
@@ -214,8 +226,11 @@ def parse_instruction(text: str) -> ParsedQuery:
     cat, span, _ = _find_category(words)
     q.category = cat
     known = (set(_FILLER) | set(LEXICON) | set(ALIASES) | set(_SHAPES) | set(_SIZE_WORDS) | set(_SUPERLATIVE)
-             | _MATERIALS | {"shaped", "l", "coloured", "colored", "color", "colour", "light", "dark", "navy",
-                             "blue", "grey", "gray"})
+             | _MATERIALS | _COMMON_ADJECTIVES)
+    if span is not None and span[0] > 0 and _is_compound_modifier(words[span[0] - 1], known):
+        # "pool table", "picnic table": another object whose name ends in a category word.
+        cat, span = None, None
+        q.category = None
     rest = [w for k, w in enumerate(words) if (span is None or not span[0] <= k < span[1]) and w not in known]
     if cat is None:
         q.unknown_words = rest
