@@ -22,7 +22,8 @@ from capnav.demo.report import Report, ReportItem, write_html, write_markdown
 from capnav.eval.pipeline import PipelineConfig, open_scene
 from capnav.eval.success import SUCCESS_RADIUS_M, distance_to_instances
 from capnav.mapping.objects import MapObject
-from capnav.planning import PlannerConfig, navigate_to
+from capnav.planning import PlannerConfig
+from capnav.planning.instruction import run_instruction
 from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
 
 #: One instruction of each kind by default: what CapNav is for first, then the classic cases.
@@ -145,43 +146,26 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
 
 def _answer(k: int, text: str, kind: str, targets: list[int], retriever: Retriever, agent: Any, cmap: Any,
             assets: Any, plan_cfg: PlannerConfig, out: Path) -> ReportItem:
-    from capnav.viz.topdown import write_navigation
-
-    start_pose = tuple(float(v) for v in agent.pose)
     try:
-        res = retriever.query(text, robot_xy=(start_pose[0], start_pose[1]))
+        res = run_instruction(cmap, assets.sim, retriever, text, agent=agent, config=plan_cfg,
+                              out_dir=out / "images", stem=f"{k:02d}_nav")
     except CapNavError as e:  # e.g. an empty or non-English instruction: report it, keep going
         return ReportItem(text, kind, False, None, None, None, None, f"rejected: {e}",
                           correct=None if kind == "user" else False)
-    item = ReportItem(text, kind, res.found, res.chosen.id if res.chosen else None,
-                      res.chosen.label if res.chosen else None, res.chosen.caption if res.chosen else None,
-                      res.score if res.found else None, res.reason,
-                      runners_up=[f"{o.id} {o.label} ({s:.2f})" for o, s in res.ranked[:3]],
-                      timings=dict(res.timings))
+    q, nav, obj = res.query, res.nav, res.query.chosen
+    item = ReportItem(text, kind, q.found, obj.id if obj else None, obj.label if obj else None,
+                      obj.caption if obj else None, q.score if q.found else None, q.reason,
+                      runners_up=[f"{o.id} {o.label} ({s:.2f})" for o, s in q.ranked[:3]], timings=dict(q.timings))
     if kind == "absent":
-        item.correct = not res.found
-    elif targets:
-        item.correct = False  # until the agent is seen to stop within reach of a target
-    if res.chosen is None:
-        return item
-    obj = res.chosen
-    view = _png(obj)
-    if view:
+        item.correct = not q.found
+    elif targets:  # right only when the agent stops within reach of an instance the instruction meant
+        fps = [assets.truth.footprints[t] for t in targets]
+        item.correct = nav is not None and distance_to_instances(nav.final_pose[:2], fps) <= SUCCESS_RADIUS_M
+    if obj is not None and (view := _png(obj)):
         item.view_png = f"images/{k:02d}_view.png"
         write_bytes(out / item.view_png, view)
-    try:
-        nav = navigate_to(agent, cmap.occupancy, obj.footprint, plan_cfg)
-    except CapNavError as e:
-        item.reached, item.nav_reason = False, f"could not plan: {e}"
-        return item
-    item.reached, item.nav_reason, item.path_length = nav.reached, nav.reason, nav.path_length
-    if targets:
-        fps = [assets.truth.footprints[t] for t in targets]
-        item.correct = distance_to_instances(nav.final_pose[:2], fps) <= SUCCESS_RADIUS_M
-    png, _ = write_navigation(out / "images", f"{k:02d}_nav", cmap.occupancy, cmap.objects, obj.id,
-                              nav.waypoints, nav.trajectory, start_pose, nav.final_pose, text,
-                              goal=None if nav.goal is None else (*nav.goal.xy, nav.goal.yaw), reach=plan_cfg.reach)
-    item.map_png = f"images/{png.name}"
+    if nav is not None:
+        item.reached, item.nav_reason, item.path_length = nav.reached, nav.reason, nav.path_length
+    if res.png is not None:
+        item.map_png = f"images/{res.png.name}"
     return item
-
-

@@ -88,13 +88,23 @@ def planning_occupancy(cmap: CapNavMap, sim: Simulator, kind: str) -> OccupancyG
 
 
 def run_instruction(cmap: CapNavMap, sim: Simulator, retriever: Retriever, instruction: str,
-                    start: tuple[float, float, float], occupancy: str = "mapped",
+                    start: tuple[float, float, float] | None = None, occupancy: str = "mapped",
                     config: PlannerConfig | None = None, out_dir: str | Path | None = None,
-                    stem: str = "navigate") -> InstructionOutcome:
-    """Retrieve, plan, execute; with ``out_dir`` write ``<stem>.png`` and ``<stem>.json``."""
+                    stem: str = "navigate", agent: Any | None = None) -> InstructionOutcome:
+    """Retrieve, plan, execute; with ``out_dir`` write ``<stem>.png`` and ``<stem>.json``.
+
+    Give either ``start`` (a new agent is spawned there) or a live ``agent`` (it goes on from where
+    it stands, as in a chain of instructions).
+    """
     cfg = config or PlannerConfig()
     occ = planning_occupancy(cmap, sim, occupancy)
-    agent = sim.spawn_agent(*start)
+    if agent is None:
+        if start is None:
+            raise InputError("run_instruction needs a start pose or an agent")
+        agent = sim.spawn_agent(*start)
+    else:
+        x, y, yaw = agent.pose
+        start = (float(x), float(y), float(yaw))
     query = retriever.query(instruction, robot_xy=(start[0], start[1]))
     nav = None
     if query.found and query.chosen is not None:
