@@ -20,7 +20,7 @@ def test_render_tables() -> None:
                        "episodes_per_scene": 2}, [{"method": "vlmaps", "protocol": "label", "episode_id": "e",
                                                    "index": 1, "text": "sofa", "reason": "wrong sofa",
                                                    "distance_to_goal": 2.5, "picture": "pictures/x.png"}],
-                {"map": 1.0})
+                {"map": 1.0}, {"vlmaps": "VLMaps-style:\n  dense features."})
     lines = md.splitlines()
     row = next(ln for ln in lines if ln.startswith("| capnav |"))
     # ours 100 / 50 / 50 / 25 beside the paper's 62 / 40 / 22 / 14
@@ -32,6 +32,7 @@ def test_render_tables() -> None:
     assert "| 25.0 | 62.5 | 0.0 | 50.0 | 15.4 | 56.6 |" in t2
     t2b = next(ln for ln in lines if ln.startswith("| capnav-no-verify ("))
     assert "| – | – | 7.7 | 51.9 |" in t2b
+    assert "- **vlmaps**: VLMaps-style: dense features." in md
     assert "## Description protocol" in md and "![](pictures/x.png)" in md and "seed 3" in md
     # vlmaps comes before capnav in Table 1 (baselines first, as in the paper)
     assert lines.index(vl) < lines.index(row)

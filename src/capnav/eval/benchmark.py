@@ -27,7 +27,7 @@ from typing import Any
 from capnav.core.atomic import write_json, write_text
 from capnav.core.errors import InputError
 from capnav.eval.episodes import EpisodeSet
-from capnav.eval.method import load_methods
+from capnav.eval.method import load_methods, method_note
 from capnav.eval.metrics import SubgoalRecord, Summary, summarize_all
 from capnav.eval.parallel import run_tasks
 from capnav.eval.report import render
@@ -121,7 +121,8 @@ def run_benchmark(config: EvalConfig, out: str | Path, workers: int = 1, ray_add
     write_json(out / "results.json", {**meta, "seconds": seconds, "timings": dict(timings),
                                       "summaries": [s.to_dict() for s in summaries],
                                       "maps": {str(r["scene_seed"]): r["map"] for r in results}})
-    write_text(out / "report.md", render(summaries, meta, _pick_failures(failures), timings))
+    notes = {m: method_note(m) for m in config.methods}
+    write_text(out / "report.md", render(summaries, meta, _pick_failures(failures), timings, notes))
     return BenchmarkResult(out, summaries, records, seconds)
 
 

@@ -123,3 +123,13 @@ def create_method(name: str, **cfg: Any) -> NavMethod:
     """Build a registered method by name (``InputError`` listing the names if unknown)."""
     load_methods()
     return METHODS.create(name, **cfg)
+
+
+def method_note(name: str) -> str:
+    """The docstring of the module that implements method ``name`` (what it is, how it differs)."""
+    import sys
+
+    load_methods()
+    m = METHODS.create(name)
+    doc = sys.modules[type(m).__module__].__doc__ or ""
+    return doc.strip()

@@ -73,7 +73,8 @@ def details(summaries: Sequence[Summary]) -> list[str]:
 
 
 def render(summaries: Sequence[Summary], config: Mapping[str, Any],
-           failures: Sequence[Mapping[str, Any]] = (), timings: Mapping[str, float] | None = None) -> str:
+           failures: Sequence[Mapping[str, Any]] = (), timings: Mapping[str, float] | None = None,
+           notes: Mapping[str, str] | None = None) -> str:
     """The whole report as Markdown. ``failures`` items: method, protocol, episode_id, index, text,
     reason, distance_to_goal, picture (relative path or empty)."""
     out = ["# CapNav benchmark report", ""]
@@ -98,6 +99,9 @@ def render(summaries: Sequence[Summary], config: Mapping[str, Any],
     out += table1(summaries, "description")
     out += ["", "## Details", ""]
     out += details(summaries)
+    if notes:
+        out += ["", "## Methods: what each one is, and how it differs from its original", ""]
+        out += [f"- **{name}**: {' '.join(text.split())}" for name, text in notes.items()]
     if timings:
         out += ["", "## Where the time went (s, summed over workers)", "",
                 "| Stage | Seconds |", "|---|---:|"]
