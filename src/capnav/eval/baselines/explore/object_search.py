@@ -38,6 +38,7 @@ class ObjectSearchConfig:
     stop_distance: float = 0.8  # m from the sighted goal's centre (success is 1 m from its footprint)
     cluster_radius: float = 1.0  # m, sightings this close to the chosen one refine its position
     remember: bool = True  # goal sightings from earlier subgoals of the episode count
+    vote_radius: float = 0.5  # m; a goal sighting outvoted by other labels this close is a confusion (0: off)
 
     def __post_init__(self) -> None:
         if not (0.0 <= self.goal_score <= 1.0) or self.stop_distance <= 0 or self.cluster_radius <= 0:
@@ -88,12 +89,16 @@ class ObjectSearch(ABC):
         matcher = self._timed(GoalMatcher, goal_text, self.ctx.embedder, cfg.match_threshold)
         what = matcher.category or repr(goal_text)
 
-        def goal_in(pool: Sequence[Sighting]) -> list[Sighting]:
+        def goal_in(pool: Sequence[Sighting], voters: Sequence[Sighting] | None = None) -> list[Sighting]:
             t0 = time.perf_counter()
             good = [s for s in pool if s.score >= cfg.goal_score]
             ok = matcher.accepts([s.label for s in good]) if good else np.zeros(0, bool)
+            hits = [s for s, a in zip(good, ok, strict=True) if a]
+            if hits and cfg.vote_radius > 0:
+                out = _outvoted(hits, ex.sightings if voters is None else voters, matcher, cfg.vote_radius)
+                hits = [s for s, o in zip(hits, out, strict=True) if not o]
             self._decision_time += time.perf_counter() - t0
-            return [s for s, a in zip(good, ok, strict=True) if a]
+            return hits
 
         seen = goal_in(ex.sightings) if cfg.remember else []
         status = Status.STOPPED
@@ -114,7 +119,8 @@ class ObjectSearch(ABC):
         state = {"xy": anchor.xy}
 
         def target() -> tuple[float, float]:
-            pts = [s for s in goal_in(ex.sightings) if math.dist(s.xy, state["xy"]) <= cfg.cluster_radius]
+            near = [s for s in ex.sightings if math.dist(s.xy, state["xy"]) <= cfg.cluster_radius + cfg.vote_radius]
+            pts = [s for s in goal_in(near, near) if math.dist(s.xy, state["xy"]) <= cfg.cluster_radius]
             if pts:
                 w = np.array([s.score for s in pts])
                 xy = (np.array([s.xy for s in pts]) * w[:, None]).sum(0) / w.sum()
@@ -150,3 +156,18 @@ class ObjectSearch(ABC):
             **(extra or {})}
         return SubgoalOutcome(found=found, reason=reason, target_xy=target_xy, query_time_s=self._decision_time,
                               steps=ex.steps, explanation=self.describe_choice(), extra=info)
+
+
+def _outvoted(cands: Sequence[Sighting], pool: Sequence[Sighting], matcher: GoalMatcher, radius: float
+              ) -> NDArray[np.bool_]:
+    """For each candidate goal sighting: do the sightings within ``radius`` of it, weighted by
+    confidence, vote more for other labels than for the goal? (A detector that confuses a desk
+    with a table does so in a minority of views; one confused view should not send the agent.)"""
+    pxy = np.array([s.xy for s in pool], dtype=np.float64).reshape(-1, 2)
+    w = np.array([s.score for s in pool], dtype=np.float64)
+    is_goal = matcher.accepts([s.label for s in pool])
+    cxy = np.array([s.xy for s in cands], dtype=np.float64).reshape(-1, 2)
+    near = ((cxy[:, None, :] - pxy[None, :, :]) ** 2).sum(-1) <= radius**2  # (C, P)
+    for_goal = (near * (w * is_goal)[None, :]).sum(axis=1)
+    against = (near * (w * ~is_goal)[None, :]).sum(axis=1)
+    return np.asarray(against > for_goal)
