@@ -173,7 +173,8 @@ def _doors(rects: list[Rect], types: list[str], cfg: LayoutConfig, rng: np.rando
             chosen.append(e)
     doors = []
     for i, j, (axis, coord, lo, hi) in chosen:
-        c = float(np.round(rng.uniform(lo + margin + cfg.door_width / 2, hi - margin - cfg.door_width / 2), 2))
+        a, b = lo + margin + cfg.door_width / 2, hi - margin - cfg.door_width / 2
+        c = float(np.round(rng.uniform(a, max(a, b)), 2))
         doors.append(DoorSpec((i, j), axis, coord, c - cfg.door_width / 2, c + cfg.door_width / 2))
     return doors
 
