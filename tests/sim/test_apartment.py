@@ -128,3 +128,23 @@ def test_many_seeds_generate() -> None:
     for s in range(40, 52):
         apt = generate_apartment(s, SimConfig())
         assert apt.objects and len(apt.plan.doors) >= len(apt.plan.rooms) - 1
+
+
+def test_placement_is_plausible(apt) -> None:  # type: ignore[no-untyped-def]
+    walls = apt.wall_rects
+    rooms = {r.id: r.name for r in apt.manifest.rooms}
+    for o in apt.objects:
+        if o.category in ("bed", "wardrobe", "bookshelf", "refrigerator", "toilet", "tv", "counter"):
+            # the back edge (local -y) touches a wall slab
+            c, s = np.cos(o.yaw), np.sin(o.yaw)
+            back = np.array([o.x, o.y]) - (o.model.size[1] / 2) * np.array([-s, c])
+            assert walls.min_distance(back[None])[0] < 0.03, (o.category, o.id)
+        room = rooms[f"room{o.room}"]
+        if o.category in ("toilet", "bathtub"):
+            assert room == "bathroom"
+        if o.category == "bed":
+            assert room == "bedroom"
+        if o.category == "nightstand":  # beside a bed
+            beds = [b for b in apt.objects if b.category == "bed"]
+            fp = RectSet.from_lists([(b.x, b.y) for b in beds], [b.model.size[:2] for b in beds], [b.yaw for b in beds])
+            assert fp.min_distance(o.footprint()).min() < 0.1

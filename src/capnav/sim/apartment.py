@@ -232,6 +232,12 @@ def _prune_unreachable(items: list[SceneObject], walls: RectSet, bounds: tuple[f
         items = items[:drop] + items[drop + 1:]
 
 
+def _drop_orphans(items: list[SceneObject]) -> list[SceneObject]:
+    """Nightstands only make sense beside a bed of their room."""
+    bed_rooms = {o.room for o in items if o.category == "bed"}
+    return [o for o in items if o.category != "nightstand" or o.room in bed_rooms]
+
+
 def generate_apartment(seed: int, cfg: SimConfig) -> Apartment:
     """Deterministic apartment for ``seed``: every object reachable, some category with >= 3 instances."""
     if not isinstance(seed, (int, np.integer)) or isinstance(seed, bool) or seed < 0 or seed >= 2**32:
@@ -243,18 +249,26 @@ def generate_apartment(seed: int, cfg: SimConfig) -> Apartment:
     srng = np.random.default_rng([seed, 3])
     floors = [ROOM_FLOORS[t][int(srng.integers(len(ROOM_FLOORS[t])))] for t in plan.types]
     wall_colors = [ROOM_WALLS[int(srng.integers(len(ROOM_WALLS)))] for _ in plan.types]
-    for attempt in range(20):
+    best: list[SceneObject] | None = None
+    best_lost = 10**9
+    for attempt in range(12):  # keep the furnishing that loses fewest objects to the reachability check
         rng = np.random.default_rng([seed, 2, attempt])
-        items = [SceneObject(0, p.category, p.model, p.x, p.y, p.yaw, p.room, name, material, roles)
-                 for p, name, material, roles in _fill(plan, cfg, rng)]
-        items = _prune_unreachable(items, walls, bounds, cfg)
+        placed = [SceneObject(0, p.category, p.model, p.x, p.y, p.yaw, p.room, name, material, roles)
+                  for p, name, material, roles in _fill(plan, cfg, rng)]
+        items = _drop_orphans(_prune_unreachable(placed, walls, bounds, cfg))
         counts: dict[str, int] = {}
         for o in items:
             counts[o.category] = counts.get(o.category, 0) + 1
-        if counts and max(counts.values()) >= 3:
+        if not counts or max(counts.values()) < 3:
+            continue
+        lost = len(placed) - len(items)
+        if lost < best_lost:
+            best, best_lost = items, lost
+        if lost <= 1:
             break
-    else:
+    if best is None:
         raise InputError(f"seed {seed}: could not furnish the apartment with a category of >= 3 instances")
+    items = best
     for i, o in enumerate(items):
         o.id = i + 1
     return Apartment(seed, cfg, plan, items, walls, faces, floors, wall_colors)
