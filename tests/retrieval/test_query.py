@@ -57,3 +57,14 @@ def test_bad_instructions(text, msg):
 def test_non_string():
     with pytest.raises(InputError):
         validate_instruction(None)
+
+
+def test_pipeline_never_imports_the_simulator():
+    """Captioning and retrieval work from observations only: no scene truth is even importable."""
+    import subprocess
+    import sys
+
+    code = ("import sys, capnav.language, capnav.retrieval, capnav.language.offline_captioner; "
+            "print([m for m in sys.modules if m.startswith('capnav.sim')])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
