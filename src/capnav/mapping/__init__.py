@@ -5,6 +5,7 @@ from capnav.mapping.cmap import CapNavMap
 from capnav.mapping.lifting import (
     LiftConfig,
     LiftedDetection,
+    depth_consistent,
     indexed_descriptor,
     lift_detection,
     mask_descriptor,
@@ -37,6 +38,7 @@ __all__ = [
     "VoxelConfig",
     "VoxelMap",
     "build_map",
+    "depth_consistent",
     "indexed_descriptor",
     "lift_detection",
     "map_dataset",

@@ -17,14 +17,18 @@ from capnav.perception.base import Detection
 class LiftConfig:
     """``window`` (fraction of sqrt(mask area), at least 2 px) around the mask centroid whose
     valid mask depths give the centroid's depth by median, robust to holes and to a centroid that
-    falls off a concave mask. Object points come from the mask eroded by ``erode`` px (drops
-    boundary noise and mixed-depth edge pixels) and within ``mad_k`` robust sigmas (at least
-    ``min_band`` m) of the median depth; at most ``max_points`` per detection, evenly spaced."""
+    falls off a concave mask. Object points come from mask pixels whose depth agrees within
+    ``edge_tol`` m (+1% of the depth) with the mean depth of their in-mask 3x3 neighbours (drops
+    boundary noise that spills onto the background and mixed-depth edge pixels, but keeps thin
+    parts such as lamp poles and chair legs that an erosion would delete), optionally eroded by
+    ``erode`` px, and within ``mad_k`` robust sigmas (at least ``min_band`` m) of the median
+    depth; at most ``max_points`` per detection, evenly spaced."""
 
     window: float = 0.15
-    erode: int = 1
-    mad_k: float = 3.0
-    min_band: float = 0.2
+    edge_tol: float = 0.05
+    erode: int = 0
+    mad_k: float = 4.0
+    min_band: float = 0.5
     max_points: int = 400
 
 
@@ -95,6 +99,18 @@ def outline_visibility(mask: NDArray[np.bool_], depth: NDArray[np.floating], gap
     return 1.0 - float((near_occ | on_border).sum()) / max(n_total, 1)
 
 
+def depth_consistent(mask: NDArray[np.bool_], depth: NDArray[np.floating], tol: float) -> NDArray[np.bool_]:
+    """Mask pixels whose depth is within ``tol + 1%`` of the mean of their in-mask 3x3 neighbours."""
+    d = np.where(mask & np.isfinite(depth) & (depth > 0), depth, 0.0).astype(np.float64)
+    m = (d > 0).astype(np.float64)
+    kernel = np.ones((3, 3))
+    s = ndimage.correlate(d, kernel, mode="constant") - d
+    c = ndimage.correlate(m, kernel, mode="constant") - m
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = s / c
+    return (m > 0) & (c > 0) & (np.abs(d - mean) <= tol + 0.01 * d)
+
+
 def indexed_descriptor(mask: NDArray[np.bool_], grid: NDArray[np.integer], table: NDArray[np.float32],
                        offset: tuple[int, int] = (0, 0), image_shape: tuple[int, int] | None = None
                        ) -> NDArray[np.float32]:
@@ -143,6 +159,8 @@ def lift_detection(frame: Frame, det: Detection, index: int, grid: NDArray[np.in
     pos = T[:3, :3] @ pc + T[:3, 3]
 
     core = ndimage.binary_erosion(mask, iterations=cfg.erode) if cfg.erode > 0 else mask
+    if cfg.edge_tol > 0:
+        core = core & depth_consistent(mask, depth, cfg.edge_tol)
     pv, pu = np.nonzero(core)
     if pv.size < 8:
         pv, pu = vs, us
