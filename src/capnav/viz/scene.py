@@ -118,3 +118,31 @@ def _door_ends(center: tuple[float, float], width: float, m: SceneManifest) -> t
         if min(abs(cx - min(xs)), abs(cx - max(xs))) < 1e-6:
             return (cx, cy - width / 2), (cx, cy + width / 2)
     return (cx - width / 2, cy), (cx + width / 2, cy)
+
+
+def render_docs(seed: int, out: str | Path) -> list[Path]:
+    """The pictures under docs/sim: 12 exploration frames, 2 frames with their truth images, the map.
+
+    ``python -m capnav.viz.scene --seed 3 --out docs/sim`` regenerates them.
+    """
+    from capnav.sim import ExploreConfig, Simulator, explore
+
+    out = Path(out)
+    with Simulator.from_seed(seed) as sim:
+        frames = list(explore(sim, ExploreConfig(seed=seed)))
+        pick = [frames[i] for i in np.linspace(0, len(frames) - 1, 12).astype(int)]
+        traj = np.array([f.T_wc[:2, 3] for f in frames])
+        return [frame_grid(pick, out / "frames.png", cols=4),
+                frame_grid([frames[len(frames) // 3], frames[2 * len(frames) // 3]], out / "truth.png", truth=True),
+                draw_scene(sim.manifest, out / "topdown.png", navigable=sim.navigable(), trajectory=traj, dpi=80)]
+
+
+if __name__ == "__main__":
+    import argparse
+
+    ap = argparse.ArgumentParser(description="Regenerate the simulator pictures of docs/sim.")
+    ap.add_argument("--seed", type=int, default=3)
+    ap.add_argument("--out", default="docs/sim")
+    a = ap.parse_args()
+    for p in render_docs(a.seed, a.out):
+        print(p)
