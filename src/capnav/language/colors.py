@@ -123,9 +123,16 @@ def canonical_color(word: str) -> str | None:
     return ALIASES.get(w)
 
 
+#: Understood in queries but not used to name colours: "silver" is a metallic sheen that a
+#: colour alone cannot show, so such surfaces are named "light grey" (a ΔE00 of about 5 away).
+QUERY_ONLY: frozenset[str] = frozenset({"silver"})
+_NAMING = np.array([n not in QUERY_ONLY for n in NAMES])
+
+
 def name_lab(lab: NDArray[np.floating], kL: float = 2.0) -> tuple[str, float]:
-    """Nearest lexicon colour of one Lab colour and its CIEDE2000 distance."""
+    """Nearest naming colour of one Lab colour and its CIEDE2000 distance."""
     d = ciede2000(np.asarray(lab, dtype=np.float64)[None, :], LEX_LAB, kL=kL)
+    d = np.where(_NAMING, d, np.inf)
     i = int(np.argmin(d))
     return NAMES[i], float(d[i])
 
