@@ -50,6 +50,8 @@ class LMNavMethod:
         self.driver: FrontierExplorer | None = None
 
     def start_episode(self, ctx: SceneContext, agent: Agent) -> None:
+        if ctx.detector is None:
+            raise InputError(f"method {self.name!r} needs the shared detector to describe its graph nodes")
         key = f"lmnav/graph/{self.config.graph!r}"
         if key not in ctx.cache:
             ctx.cache[key] = build_graph(frames_of(ctx.frames), ctx.detector, self.config.graph)
