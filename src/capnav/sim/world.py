@@ -244,13 +244,14 @@ class BulletWorld:
         return rgba, depth, seg
 
     def close(self) -> None:
-        if self.client >= 0:
+        if getattr(self, "client", -1) >= 0:
             try:
                 self.p.disconnect(physicsClientId=self.client)
             except Exception:  # already disconnected (interpreter shutdown)
                 pass
             self.client = -1
-        shutil.rmtree(self._tmp, ignore_errors=True)
+        if hasattr(self, "_tmp"):
+            shutil.rmtree(self._tmp, ignore_errors=True)
 
     def __del__(self) -> None:
         self.close()
