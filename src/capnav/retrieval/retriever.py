@@ -28,7 +28,7 @@ from capnav.retrieval.config import RetrievalConfig
 from capnav.retrieval.query import ParsedQuery, parse_instruction
 from capnav.retrieval.ranking import cosine_scores, mmr, top_k
 from capnav.retrieval.result import QueryResult
-from capnav.retrieval.verifier import AcceptFirst, Candidate, OfflineVerifier, Verifier
+from capnav.retrieval.verifier import AcceptFirst, Candidate, OfflineVerifier, Verifier, a
 
 _VOCAB = set(NAMES)
 _ROOMS = list(ROOM_CUES)
@@ -208,7 +208,7 @@ class Retriever:
                  notes: list[str], verdict: str, dist: float | None, verifier: Verifier) -> str:
         target = q.target_phrase or q.text
         if i is None:
-            base = f"Not found: nothing in the map is a {target}"
+            base = f"Not found: nothing in the map is {a(target)}"
             return f"{base} ({verdict})." + (f" {'; '.join(notes)}." if notes else "")
         o = self.objects[i]
         how = {"closest": f"it is the {predicate} {q.category or target} to the robot"

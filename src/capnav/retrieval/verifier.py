@@ -37,6 +37,11 @@ from capnav.retrieval.query import ParsedQuery
 log = logging.getLogger(__name__)
 
 
+def a(noun: str) -> str:
+    """'a chair', 'an armchair'."""
+    return f"an {noun}" if noun[:1].lower() in "aeiou" else f"a {noun}"
+
+
 @dataclass
 class Candidate:
     obj: MapObject
@@ -123,15 +128,15 @@ class OfflineVerifier(Verifier):
         name = caption_name(obj.caption or obj.label)
         cat = canonical_label(name)
         if q.category is not None and (cat == q.category or canonical_label(obj.label) == q.category):
-            return True, f"it is a {q.category}"
+            return True, f"it is {a(q.category)}"
         noun = q.category or (" ".join(q.unknown_words) if q.unknown_words else q.target_phrase)
         if self.embedder is None or not noun:
-            return False, f"it is a {name}, not a {noun}"
+            return False, f"it is {a(name)}, not {a(noun)}"
         v = self.embedder.embed([noun, name])
         sim = float(v[0] @ v[1])
         if sim >= self.config.name_threshold:
             return True, f"'{name}' matches '{noun}' (similarity {sim:.2f})"
-        return False, f"it is a {name}, not a {noun} (similarity {sim:.2f})"
+        return False, f"it is {a(name)}, not {a(noun)} (similarity {sim:.2f})"
 
     def _color(self, q: ParsedQuery, obj: MapObject) -> tuple[float, str]:
         cols = self.colors(obj)
