@@ -245,8 +245,10 @@ def _offline(embedder: TextEmbedder | None = None, **kw: Any) -> OfflineVerifier
 
 def _vlm_factory(backend: str) -> Callable[..., VLMVerifier]:
     def make(retry: RetryPolicy | None = None, fallback: Verifier | None = None, cache: dict[str, Any] | None = None,
-             sleep: Callable[[float], None] = time.sleep, **client_kw: Any) -> VLMVerifier:
-        return VLMVerifier(create_vlm(backend, **client_kw), retry=retry, fallback=fallback, cache=cache, sleep=sleep)
+             sleep: Callable[[float], None] = time.sleep, embedder: TextEmbedder | None = None,
+             **client_kw: Any) -> VLMVerifier:
+        fb = fallback if fallback is not None else OfflineVerifier(embedder=embedder)
+        return VLMVerifier(create_vlm(backend, **client_kw), retry=retry, fallback=fb, cache=cache, sleep=sleep)
 
     return make
 
