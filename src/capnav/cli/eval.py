@@ -29,6 +29,7 @@ def register(app: typer.Typer) -> None:
         height: Annotated[int, typer.Option(help="camera height (pixels)")] = 240,
         max_frames: Annotated[int | None, typer.Option(help="use at most this many exploration frames")] = None,
         pictures: Annotated[int, typer.Option(help="failure pictures per method, protocol and apartment")] = 1,
+        max_steps: Annotated[int, typer.Option(help="action budget per subgoal of the exploring methods")] = 200,
         progress: Annotated[bool, typer.Option(help="show progress")] = True,
     ) -> None:
         """Run every method on the same apartments, maps and episodes; write results.json and report.md."""
@@ -45,7 +46,7 @@ def register(app: typer.Typer) -> None:
         else:
             names = tuple(m.strip() for m in methods.split(",") if m.strip())
         cfg = EvalConfig(scenes=scenes, episodes_per_scene=episodes_per_scene, seed=seed, methods=names,
-                         protocols=tuple(parse_protocols(protocols)), pictures_per_scene=pictures,
+                         protocols=tuple(parse_protocols(protocols)), pictures_per_scene=pictures, max_steps=max_steps,
                          pipeline=PipelineConfig(width=width, height=height, max_frames=max_frames))
         res = run_benchmark(cfg, out, workers=workers, ray_address=ray, episodes_dir=episodes, progress=progress,
                             command=" ".join(["capnav", *map(shlex.quote, sys.argv[1:])]))

@@ -43,7 +43,10 @@ class EvalConfig:
     protocols: tuple[str, ...] = PROTOCOLS
     subgoals: int = 4
     pipeline: PipelineConfig = field(default_factory=PipelineConfig)
-    max_steps: int = 500  # motion budget per subgoal for step-driven methods
+    # Motion budget per subgoal for step-driven (exploring) methods: Habitat's ObjectNav allows 500
+    # actions in Matterport houses of a few hundred m²; these apartments are 40-110 m², and 200
+    # actions (50 m of forward motion at 0.25 m a step) cross one several times.
+    max_steps: int = 200
     pictures_per_scene: int = 1  # failure pictures per (method, protocol) and apartment
     method_options: dict[str, dict[str, Any]] = field(default_factory=dict)
 
