@@ -8,7 +8,6 @@ Each subgoal starts where the previous one stopped.
 
 from __future__ import annotations
 
-import math
 import time
 from typing import Any
 
@@ -104,7 +103,3 @@ def run_episode(method: NavMethod, ctx: SceneContext, episode: Episode, truth: S
             chosen_object=out.chosen_object, explanation=out.explanation,
             trajectory=[(round(x, 3), round(y, 3)) for x, y in traj], error=error))
     return records
-
-
-def finite_or_none(x: float) -> float | None:
-    return x if math.isfinite(x) else None
