@@ -77,9 +77,12 @@ class Retriever:
         self.cats_arr = np.array(self.cats, dtype=object)
         self.volume = self.scene.volume
         self.verifier = verifier if verifier is not None else OfflineVerifier()
+        offline = getattr(self.verifier, "fallback", None)
         if isinstance(self.verifier, OfflineVerifier):
-            self.verifier.bind(embedder, self.scene)
-            self.verifier.use_attributes(cmap.caches.get("attributes", {}))
+            offline = self.verifier
+        if isinstance(offline, OfflineVerifier):
+            offline.bind(embedder, self.scene)
+            offline.use_attributes(cmap.caches.get("attributes", {}))
         cache = cmap.caches.setdefault("verifications", {})
         if hasattr(self.verifier, "cache") and getattr(self.verifier, "cache", None) == {}:
             self.verifier.cache = cache
