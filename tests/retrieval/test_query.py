@@ -17,6 +17,8 @@ from capnav.retrieval import parse_instruction, validate_instruction
     ("take me to the chiar", {"category": "chair"}),  # a typo
     ("the lamp bseide the stove", {"category": "lamp", "relation": "next to", "anchor_category": "stove"}),
     ("the closest bedside table", {"category": "nightstand", "proximity": "closest"}),
+    ("the longe chair", {"category": "armchair"}), ("the cofee table", {"category": "coffee table"}),
+    ("Navigate to the bedsde table.", {"category": "nightstand"}), ("the wood table", {"category": "table"}),
     ("the plant in the yellow terracotta pot", {"category": "plant", "colors": ["yellow"]}),
     ("the gray armchair beside the lamp in the study",
      {"category": "armchair", "colors": ["grey"], "relation": "next to", "anchor_category": "lamp",

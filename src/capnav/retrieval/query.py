@@ -31,6 +31,7 @@ _EXTRA_FORMS = {"couches": "sofa", "sofas": "sofa", "chairs": "chair", "tables":
                 "sofa bed": "sofa", "settees": "sofa", "coffee tables": "coffee table"}
 _FORM_MAP: dict[str, str] = {**{f: c for f, c in _FORMS}, **_EXTRA_FORMS}
 _FORM_WORDS = {w for f in _FORM_MAP for w in f.split()}
+_MULTI_FORMS = sorted(f for f in _FORM_MAP if " " in f)
 _SINGLE_FORMS = sorted({f for f in _FORM_MAP if " " not in f and len(f) >= 4})
 
 _PROXIMITY = {"closest": "closest", "nearest": "closest", "near me": "closest", "closest to me": "closest",
@@ -119,11 +120,20 @@ def validate_instruction(text: object) -> str:
 
 def _find_category(words: list[str]) -> tuple[str | None, tuple[int, int] | None, bool]:
     """(category, word span, fuzzy) of the first category mention; exact n-grams before typos."""
-    for n in (3, 2, 1):
+    for n in (3, 2):
         for i in range(len(words) - n + 1):
             gram = " ".join(words[i:i + n])
             if gram in _FORM_MAP:
                 return _FORM_MAP[gram], (i, i + n), False
+    # A typo in a multi-word name ("longe chair") before the exact single word inside it ("chair").
+    for n in (3, 2):
+        for i in range(len(words) - n + 1):
+            near = difflib.get_close_matches(" ".join(words[i:i + n]), _MULTI_FORMS, n=1, cutoff=0.88)
+            if near:
+                return _FORM_MAP[near[0]], (i, i + n), True
+    for i in range(len(words)):
+        if words[i] in _FORM_MAP:
+            return _FORM_MAP[words[i]], (i, i + 1), False
     for i, w in enumerate(words):
         if len(w) < 4 or w in _FILLER or canonical_color(w) or w in _SHAPES or w in _SIZE_WORDS:
             continue
@@ -159,12 +169,17 @@ _COMMON_ADJECTIVES = {"shaped", "l", "coloured", "colored", "color", "colour", "
                       "only", "usual", "favourite", "favorite", "pretty", "modern", "classic", "comfy", "comfortable"}
 
 
+def _ratio(a: str, b: str) -> float:
+    return difflib.SequenceMatcher(None, a, b).ratio()
+
+
 def _fix_keyword_typos(words: list[str]) -> list[str]:
     out = []
     for w in words:
         if len(w) >= 5 and w not in _ENGLISH_HINTS and w not in _FORM_WORDS:
             near = difflib.get_close_matches(w, _KEYWORDS, n=1, cutoff=0.8)
-            if near:
+            # Only when no category word is at least as close ("bedsde" is "bedside", not "beside").
+            if near and _ratio(w, near[0]) > max((_ratio(w, f) for f in _FORM_WORDS), default=0.0):
                 w = near[0]
         out.append(w)
     return out
