@@ -69,7 +69,7 @@ class Mapper:
         proj = None
         if vc.feature_dim is not None and vc.feature_dim < d_in:
             proj = random_projection(d_in, vc.feature_dim, vc.projection_seed)
-        self.voxels = VoxelMap(vc.resolution, vc.origin, proj.shape[1] if proj is not None else d_in, proj,
+        self.voxels = VoxelMap(vc.resolution, vc.grid_origin, proj.shape[1] if proj is not None else d_in, proj,
                                encoder.text_space)
         self.tracker = SG3DTracker(self.config.tracker)
         self.memory = ObjectMemory(self.config.memory)
