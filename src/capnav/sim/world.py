@@ -140,16 +140,10 @@ class BulletWorld:
 
     # -- structure -------------------------------------------------------------------------
     def _build_structure(self, apt: Apartment) -> None:
+        """Walls first, then floors, then ceilings: drawing order is creation order, and walls hide
+        most of what lies behind them (the renderer's depth test then skips shading it)."""
         H = apt.config.layout.wall_height
-        for k, r in enumerate(apt.plan.rooms):
-            floor, ceil = Mesh(), Mesh()
-            for x0, x1 in _tiles(r.x0, r.x1, self.tile):
-                for y0, y1 in _tiles(r.y0, r.y1, self.tile):
-                    floor.quad(np.array([[x0, y0, 0], [x1, y0, 0], [x1, y1, 0], [x0, y1, 0]]), (0, 0, 1))
-                    ceil.quad(np.array([[x0, y0, H], [x0, y1, H], [x1, y1, H], [x1, y0, H]]), (0, 0, -1))
-            pattern, rgb = apt.floor_styles[k]
-            self.room_bodies[k].append(self._mesh_body(floor, rgb, pattern))
-            self.room_bodies[k].append(self._mesh_body(ceil, CEILING, None))
+        for k in range(len(apt.plan.rooms)):
             walls = Mesh()
             for f in (f for f in apt.wall_faces if f.room == k):
                 p0, p1 = np.array(f.p0), np.array(f.p1)
@@ -164,6 +158,18 @@ class BulletWorld:
                                              [qa[0], qa[1], z1]]), (f.normal[0], f.normal[1], 0.0))
             if walls.v:
                 self.room_bodies[k].append(self._mesh_body(walls, apt.wall_colors[k], None))
+        for level in ("floor", "ceiling"):
+            for k, r in enumerate(apt.plan.rooms):
+                mesh = Mesh()
+                for x0, x1 in _tiles(r.x0, r.x1, self.tile):
+                    for y0, y1 in _tiles(r.y0, r.y1, self.tile):
+                        if level == "floor":
+                            mesh.quad(np.array([[x0, y0, 0], [x1, y0, 0], [x1, y1, 0], [x0, y1, 0]]), (0, 0, 1))
+                        else:
+                            mesh.quad(np.array([[x0, y0, H], [x0, y1, H], [x1, y1, H], [x1, y0, H]]), (0, 0, -1))
+                pattern, rgb = apt.floor_styles[k]
+                body = self._mesh_body(mesh, rgb, pattern) if level == "floor" else self._mesh_body(mesh, CEILING, None)
+                self.room_bodies[k].append(body)
 
     # -- furniture -------------------------------------------------------------------------
     def _part_shape(self, part: Part, rgb: RGB) -> int:
