@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from capnav.core.errors import CapNavError, InputError
 from capnav.core.frame import Frame
-from capnav.core.grid import FREE, OccupancyGrid
+from capnav.core.grid import FREE, UNKNOWN, GridSpec, OccupancyGrid
 from capnav.eval.baselines.explore.frontier import Frontier, find_frontiers
 from capnav.eval.baselines.explore.online_map import OnlineMap, OnlineMapConfig
 from capnav.eval.baselines.explore.sighting import Sighting, lift
@@ -130,9 +130,41 @@ class FrontierExplorer:
                 return Status.STOPPED
         return Status.ARRIVED
 
+    def face(self, xy: tuple[float, float], stop: StopCheck | None = None) -> Status:
+        """Turn in place towards ``xy`` (a frontier's unknown side), observing at every heading."""
+        x, y, yaw = (float(v) for v in self.agent.pose)
+        if math.dist((x, y), xy) < 1e-6:
+            return Status.ARRIVED
+        err = _wrap(math.atan2(xy[1] - y, xy[0] - x) - yaw)
+        for _ in range(int(abs(err) / self.turn + 0.5)):
+            if self.budget <= 0:
+                return Status.BUDGET
+            self.act("turn_left" if err > 0 else "turn_right")
+            if stop is not None and stop(self):
+                return Status.STOPPED
+        return Status.ARRIVED
+
     # ------------------------------------------------------------------ planning
-    def grid(self) -> OccupancyGrid:
-        return self.map.grid()
+    def grid(self, margin: float = 1.0) -> OccupancyGrid:
+        """The online map cropped to its known part plus ``margin`` metres (and the agent).
+
+        Planning floods unknown space at the planner's unknown cost, so the crop keeps every
+        search (inflation, cost field, A*) proportional to the explored area, not to the whole
+        fixed-size online grid.
+        """
+        full = self.map.grid()
+        known = full.cells != UNKNOWN
+        spec = full.spec
+        rows, cols = np.nonzero(known)
+        a = spec.to_cell(np.asarray(self.xy))
+        k = int(np.ceil(margin / spec.resolution))
+        r0 = max(min(int(rows.min()) if rows.size else int(a[0]), int(a[0])) - k, 0)
+        r1 = min(max(int(rows.max()) if rows.size else int(a[0]), int(a[0])) + k + 1, spec.rows)
+        c0 = max(min(int(cols.min()) if cols.size else int(a[1]), int(a[1])) - k, 0)
+        c1 = min(max(int(cols.max()) if cols.size else int(a[1]), int(a[1])) + k + 1, spec.cols)
+        sub = GridSpec(spec.x0 + c0 * spec.resolution, spec.y0 + r0 * spec.resolution, spec.resolution,
+                       r1 - r0, c1 - c0)
+        return OccupancyGrid(sub, full.cells[r0:r1, c0:c1].copy())
 
     def costmap(self, grid: OccupancyGrid) -> Costmap:
         return build_costmap(grid, self.config.planner)
@@ -248,8 +280,8 @@ class FrontierExplorer:
             f = fronts[int(np.argmax(scores))]
             st = self.drive_to(f.target_xy, stop)
             self.spent.append(f.target_xy)
-            if st is Status.ARRIVED and self.config.look_around:
-                st = self.look_around(stop)
+            if st is Status.ARRIVED:
+                st = self.look_around(stop) if self.config.look_around else self.face(f.centroid_xy, stop)
             if st in (Status.STOPPED, Status.BUDGET):
                 return st
         return Status.BUDGET
