@@ -149,7 +149,7 @@ def detector_stats(frames: list) -> list[list[str]]:
 
 def fusion_vs_open3d(frames: list) -> list[list[str]]:
     from capnav.core.geometry import backproject
-    from capnav.mapping import VoxelMap
+    from capnav.mapping import VoxelConfig, VoxelMap
 
     pts, cols = [], []
     for f in frames:
@@ -163,10 +163,11 @@ def fusion_vs_open3d(frames: list) -> list[list[str]]:
     phi = np.random.default_rng(0).standard_normal((64, 64)).astype(np.float32)
     fidx = np.random.default_rng(1).integers(0, 64, n)
     rows = []
+    origin = VoxelConfig().grid_origin
     for dim in (64, 1):
-        vm = VoxelMap(0.05, feature_dim=dim)
+        vm = VoxelMap(0.05, origin, feature_dim=dim)
         vm.integrate(p[:1000], alpha[:1000], c[:1000], fidx[:1000], phi[:, :dim])  # compile / warm
-        vm = VoxelMap(0.05, feature_dim=dim)
+        vm = VoxelMap(0.05, origin, feature_dim=dim)
         t0 = time.perf_counter()
         vm.integrate(p, alpha, c, fidx, np.ascontiguousarray(phi[:, :dim]))
         dt = time.perf_counter() - t0

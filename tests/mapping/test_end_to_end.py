@@ -56,9 +56,10 @@ def test_dense_text_query_finds_the_category(run) -> None:  # type: ignore[no-un
     assert hit.mean() > 0.7
     grid = cmap.occupancy.spec
     td = cmap.voxels.topdown_scores(emb.embed([target.category])[0], grid)
-    r, c = np.unravel_index(int(np.argmax(td)), td.shape)
-    best = grid.to_world(np.array([r, c]))
-    assert min(np.linalg.norm(best - np.array(o.center[:2])) for o in same) < max(target.size[:2])
+    rc = np.argwhere(td >= 0.9)  # cells whose best voxel reads as the category
+    xy = grid.to_world(rc)
+    near = np.min([np.linalg.norm(xy - np.array(o.center[:2]), axis=1) - max(o.size[:2]) / 2 for o in same], axis=0)
+    assert len(rc) > 20 and (near < 0.3).mean() > 0.6  # single stray cells exist (false positives)
 
 
 def test_occupancy_marks_objects_and_round_trips(run, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
