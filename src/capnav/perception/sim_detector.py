@@ -21,7 +21,9 @@ a frame's detections do not depend on the order frames are processed in:
 Measured per frame on apartment seed 0 (231 frames, ``benchmarks/bench_mapping.py``): the default
 level detects 69% of the instances showing >= 100 pixels (79% of those >= 2000 px), swaps 6.4% of
 labels, adds 0.035 false positives per frame (mean score 0.82); "hard" gives 62% / 74% / 13.4% /
-0.17. That is in the range reported for Detic with a custom vocabulary on indoor frames.
+0.17. The intent is the failure profile of an open-vocabulary detector such as Detic (small, far
+and occluded objects missed, lookalikes confused, few confident false positives); the exact
+rates of a real detector depend on the model and the scenes and were not measured here.
 ``noise="oracle"`` turns every noise source off.
 """
 
