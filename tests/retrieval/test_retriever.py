@@ -154,3 +154,24 @@ def test_verifier_registry():
     assert create_verifier("offline").name == "offline"
     with pytest.raises(InputError):
         create_verifier("nope")
+
+
+def test_plants_are_told_apart_by_their_pots(emb):
+    """Leaves dominate a plant's colours; "the plant in the blue pot" reads the base of the object."""
+    from language.synth import make_obj
+
+    plants = []
+    for oid, pot, x in ((1, (40, 70, 170), 0.0), (2, (178, 34, 34), 2.0)):
+        o = make_obj(oid, "plant", (x, 0.0), (0.5, 0.5, 1.0), (46, 120, 60))
+        low = o.points[:, 2] < 0.25
+        o.colors[low] = pot
+        plants.append(o)
+    scene = SceneContext(plants)
+    cap = create_captioner("offline")
+    for o in plants:
+        o.caption = cap.caption(o, scene).text
+        o.embedding, o.embedding_model = emb.embed([o.caption])[0], emb.model_id
+    assert "in a blue pot" in plants[0].caption and "in a red pot" in plants[1].caption
+    r = Retriever(make_map(plants), emb)
+    assert r.query("the plant in the red pot").chosen.id == 2
+    assert r.query("the plant with the blue pot").chosen.id == 1

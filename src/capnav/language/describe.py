@@ -72,8 +72,9 @@ def describe_map(cmap: CapNavMap, reader: FrameReader | None, captioner: Caption
     attrs = cmap.caches.setdefault("attributes", {})
     namer = ObservationCaptioner()
     for obj in cmap.objects:
-        attrs[str(obj.id)] = {"colors": [[c.name, *[round(v, 3) for v in c.lab], round(c.fraction, 4),
-                                          round(c.distance, 3)] for c in namer.colors(obj)]}
+        attrs[str(obj.id)] = {key: [[c.name, *[round(v, 3) for v in c.lab], round(c.fraction, 4),
+                                     round(c.distance, 3)] for c in cols]
+                              for key, cols in (("colors", namer.colors(obj)), ("base_colors", namer.base_colors(obj)))}
     t2 = time.perf_counter()
     texts = [o.caption or "" for o in cmap.objects]
     if texts:

@@ -44,6 +44,7 @@ class OfflineCaptionConfig:
     l_shape_fill: float = 0.86  # occupied share of the footprint hull below which it is L-shaped
     l_shape_min_area: float = 1.5  # m² of hull: only sofa/counter-sized objects can be L-shaped
     long_aspect: float = 2.3
+    base_fraction: float = 0.3  # lowest share of the height that holds a plant's pot
 
 
 def vote_label(obj: MapObject) -> str:
@@ -120,6 +121,17 @@ class ObservationCaptioner(Captioner):
                 rgb = px
         return object_colors(rgb.reshape(-1, 3), self.config.colors) if len(rgb) else []
 
+    def base_colors(self, obj: MapObject) -> list[ColorCluster]:
+        """Colours of the lowest part of the object (a plant's pot, a lamp's foot): points below
+        ``base_fraction`` of its height."""
+        pts, rgb = np.asarray(obj.points), np.asarray(obj.colors)
+        if len(pts) < self.config.min_points or len(rgb) != len(pts):
+            return []
+        z = pts[:, 2]
+        lo, hi = float(z.min()), float(z.max())
+        low = rgb[z <= lo + self.config.base_fraction * max(hi - lo, 1e-6)]
+        return object_colors(low.reshape(-1, 3), self.config.colors) if len(low) >= 10 else []
+
     def color_phrase(self, obj: MapObject) -> str | None:
         cols = self.colors(obj)
         if not cols:
@@ -135,6 +147,10 @@ class ObservationCaptioner(Captioner):
         color = self.color_phrase(obj)
         if color:
             out["color"] = color
+        if name == "plant":  # a plant is told apart by its pot
+            pot = self.base_colors(obj)
+            if pot:
+                out["pot"] = f"in a {pot[0].name} pot"
         size = obj.size
         out["width"] = f"{max(float(size[0]), float(size[1])):.1f} m wide"
         out["height"] = f"{float(size[2]):.1f} m tall"
@@ -164,6 +180,8 @@ class ObservationCaptioner(Captioner):
         adjs = " ".join(x for x in (p.get("size"), p.get("color"), p.get("shape")) if x)
         head = f"{adjs} {p['name']}" if adjs else p["name"]
         head = ("an " if head[0] in "aeiouAEIOU" else "a ") + head
+        if "pot" in p:
+            head += f" {p['pot']}"
         optional = [k for k in ("relative", "near", "room") if k in p]
         while True:
             parts = [f"{head}, {p['width']} and {p['height']}"]

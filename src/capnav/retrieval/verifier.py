@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import hashlib
 import logging
+import re
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable
@@ -106,6 +107,7 @@ class OfflineVerifier(Verifier):
         self.scene = scene
         self.config = config or OfflineVerifierConfig()
         self._colors: dict[int, list[ColorCluster]] = {}
+        self._base_colors: dict[int, list[ColorCluster]] = {}
         self._captioner = ObservationCaptioner()
 
     def bind(self, embedder: TextEmbedder, scene: SceneContext) -> None:
@@ -116,13 +118,20 @@ class OfflineVerifier(Verifier):
         """Colours measured by ``describe_map`` (``cmap.caches["attributes"]``), so queries need not
         recompute them."""
         for key, rec in attributes.items():
-            self._colors[int(key)] = [ColorCluster(str(n), (float(L), float(a), float(b)), float(f), float(d))
-                                      for n, L, a, b, f, d in rec.get("colors", [])]
+            for field_, store in (("colors", self._colors), ("base_colors", self._base_colors)):
+                if field_ in rec:
+                    store[int(key)] = [ColorCluster(str(n), (float(L), float(a), float(b)), float(f), float(d))
+                                       for n, L, a, b, f, d in rec[field_]]
 
     def colors(self, obj: MapObject) -> list[ColorCluster]:
         if obj.id not in self._colors:
             self._colors[obj.id] = self._captioner.colors(obj)
         return self._colors[obj.id]
+
+    def base_colors(self, obj: MapObject) -> list[ColorCluster]:
+        if obj.id not in self._base_colors:
+            self._base_colors[obj.id] = self._captioner.base_colors(obj)
+        return self._base_colors[obj.id]
 
     def _name_agreement(self, q: ParsedQuery, obj: MapObject) -> tuple[bool, str]:
         name = caption_name(obj.caption or obj.label)
@@ -139,9 +148,11 @@ class OfflineVerifier(Verifier):
         return False, f"it is {a(name)}, not {a(noun)} (similarity {sim:.2f})"
 
     def _color(self, q: ParsedQuery, obj: MapObject) -> tuple[float, str]:
-        cols = self.colors(obj)
         if not q.colors:
             return 0.0, ""
+        # "the plant in the blue pot": the colour of the object's base, not of its leaves.
+        cols = self.base_colors(obj) if re.search(r"\bpot\b", q.text.lower()) else []
+        cols = cols or self.colors(obj)
         if not cols:
             return 0.0, "its colour was not observed"
         vals = []
