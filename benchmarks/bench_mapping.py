@@ -38,11 +38,15 @@ def _table(title: str, header: list[str], rows: list[list[str]]) -> None:
         print("  ".join(str(c).ljust(w) for c, w in zip(r, widths, strict=True)))
 
 
+DEPTH_NOISE = False  # set by --depth-noise
+
+
 def render(seed: int) -> tuple[object, list]:
+    from capnav.sim.config import DepthNoiseConfig, SimConfig
     from capnav.sim.explore import ExploreConfig, explore
     from capnav.sim.simulator import Simulator
 
-    sim = Simulator.from_seed(seed)
+    sim = Simulator.from_seed(seed, SimConfig(depth_noise=DepthNoiseConfig(enabled=DEPTH_NOISE)))
     return sim, list(explore(sim, ExploreConfig(seed=0)))
 
 
@@ -274,10 +278,18 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
     ap.add_argument("--noise", default="default")
     ap.add_argument("--no-quality", action="store_true")
+    ap.add_argument("--quality-only", action="store_true")
+    ap.add_argument("--depth-noise", action="store_true", help="the simulator's Kinect-like depth noise")
     ap.add_argument("--memory-probe", type=int, default=None, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.memory_probe is not None:
         _memory_probe(args.memory_probe, args.noise)
+        return
+    global DEPTH_NOISE
+    DEPTH_NOISE = args.depth_noise
+    if args.quality_only:
+        _table(f"mapping quality, noise {args.noise!r}, detector seed 0, depth noise {args.depth_noise}",
+               ["metric", *[f"seed {s}" for s in args.seeds], "target"], quality(args.seeds, args.noise))
         return
     sim, frames = render(args.seeds[0])
     h, w = frames[0].shape
@@ -293,7 +305,7 @@ def main() -> None:
     _table(f"memory for a whole apartment (seed {args.seeds[0]})", ["what", "size"], memory(args.seeds[0], args.noise))
     sim.close()  # type: ignore[attr-defined]
     if not args.no_quality:
-        _table(f"mapping quality, noise {args.noise!r}, detector seed 0",
+        _table(f"mapping quality, noise {args.noise!r}, detector seed 0, depth noise {args.depth_noise}",
                ["metric", *[f"seed {s}" for s in args.seeds], "target"], quality(args.seeds, args.noise))
 
 
