@@ -24,15 +24,17 @@ def register(app: typer.Typer) -> None:
         """Detect, fuse the semantic voxel map, track objects and write the map file."""
         from rich.console import Console
 
+        from capnav.io.dataset import DatasetReader
         from capnav.io.mapfile import save_map
         from capnav.language import create_embedder
         from capnav.mapping import MapperConfig, map_dataset
         from capnav.perception import create_detector, create_encoder
 
+        reader = DatasetReader(dataset)  # fail on a bad folder before loading any model
         det = create_detector(detector, noise=noise, seed=seed) if detector == "sim" else create_detector(detector)
         enc = create_encoder(encoder, embedder=create_embedder(embedder))
         cfg = MapperConfig(on_bad_frame="raise" if strict else "skip")
-        cmap = map_dataset(dataset, det, enc, cfg, max_frames=max_frames, progress=progress)
+        cmap = map_dataset(reader, det, enc, cfg, max_frames=max_frames, progress=progress)
         save_map(cmap, output)
         con = Console(stderr=True)
         m = cmap.meta

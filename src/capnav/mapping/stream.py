@@ -7,18 +7,18 @@ from typing import Any
 
 from capnav.core.errors import FrameError
 from capnav.core.progress import track
+from capnav.io.dataset import DatasetReader
 from capnav.mapping.cmap import CapNavMap
 from capnav.mapping.mapper import Mapper, MapperConfig
 from capnav.perception.base import DenseFeatureEncoder, Detector
 
 
-def map_dataset(path: str | Path, detector: Detector, encoder: DenseFeatureEncoder,
+def map_dataset(path: str | Path | DatasetReader, detector: Detector, encoder: DenseFeatureEncoder,
                 config: MapperConfig | None = None, max_frames: int | None = None, progress: bool = True
                 ) -> CapNavMap:
-    """Build a map from a ``capnav-rgbd`` dataset folder (``capnav.io.dataset``)."""
-    from capnav.io.dataset import DatasetReader
-
-    reader = DatasetReader(path)
+    """Build a map from a ``capnav-rgbd`` dataset folder (``capnav.io.dataset``) or its reader."""
+    reader = path if isinstance(path, DatasetReader) else DatasetReader(path)
+    path = reader.path
     mapper = Mapper(config, detector, encoder)
     n = len(reader) if max_frames is None else min(len(reader), max_frames)
     for i in track(range(n), "mapping", total=n, enabled=progress):
