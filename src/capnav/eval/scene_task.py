@@ -51,6 +51,7 @@ class EvalConfig:
     method_options: dict[str, dict[str, Any]] = field(default_factory=dict)
 
     def scene_seeds(self) -> list[int]:
+        """Apartment seeds of this run: ``1000 * seed + i`` (seed 0: apartments 0..9)."""
         return [1000 * self.seed + i for i in range(self.scenes)]
 
     def episode_config(self) -> EpisodeConfig:
