@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from capnav.core.grid import GridSpec
-from capnav.eval.geodesic import distance_field, erode_navigable
+from capnav.eval.geodesic import distance_field
 from capnav.eval.success import distance_to_instances, footprint_distance, is_success
 
 SQUARE = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]])
@@ -62,10 +62,3 @@ def test_unreachable_and_blocked_start() -> None:
     assert field.at((2.05, 1.05)) == pytest.approx(1.0, abs=1e-6)
     assert field.at((3.55, 1.05)) == 0.0
 
-
-def test_erode_navigable() -> None:
-    free = np.ones((11, 11), dtype=bool)
-    free[5, 5] = False
-    nav = erode_navigable(free, 0.25, 0.1)
-    assert not nav[5, 7] and nav[5, 8]
-    assert nav[0, 0]  # the array border is not an obstacle

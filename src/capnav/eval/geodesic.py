@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
@@ -103,10 +102,3 @@ def distance_field(spec: GridSpec, navigable: NDArray[np.bool_], footprints: Seq
         dist[nav] = d
     return DistanceField(spec, dist, nav)
 
-
-def erode_navigable(free: NDArray[np.bool_], robot_radius: float, resolution: float) -> NDArray[np.bool_]:
-    """Cells where a disc robot of ``robot_radius`` fits (free cells farther than that from a blocked one)."""
-    if robot_radius <= 0:
-        return np.asarray(free, dtype=bool)
-    d = ndimage.distance_transform_edt(np.asarray(free, dtype=bool)) * resolution
-    return np.asarray(d > robot_radius, dtype=bool)
