@@ -166,8 +166,8 @@ class FrontierExplorer:
                        r1 - r0, c1 - c0)
         return OccupancyGrid(sub, full.cells[r0:r1, c0:c1].copy())
 
-    def costmap(self, grid: OccupancyGrid) -> Costmap:
-        return build_costmap(grid, self.config.planner)
+    def costmap(self, grid: OccupancyGrid, planner: PlannerConfig | None = None) -> Costmap:
+        return build_costmap(grid, planner or self.config.planner)
 
     def frontiers(self, grid: OccupancyGrid, cm: Costmap) -> list[Frontier]:
         """Reachable, unspent frontiers, cheapest path first.
@@ -188,12 +188,15 @@ class FrontierExplorer:
 
     # ------------------------------------------------------------------ motion
     def drive_to(self, goal_xy: tuple[float, float], stop: StopCheck | None = None, tolerance: float | None = None,
-                 goal_of: Callable[[], tuple[float, float] | None] | None = None) -> Status:
+                 goal_of: Callable[[], tuple[float, float] | None] | None = None,
+                 planner: PlannerConfig | None = None) -> Status:
         """Plan on the online map and drive with discrete actions, replanning every few steps.
 
         ``goal_of`` (optional) re-reads the goal before each replan (an approach whose target
-        estimate improves as the agent gets closer); ``tolerance`` is the arrival radius.
+        estimate improves as the agent gets closer); ``tolerance`` is the arrival radius;
+        ``planner`` overrides the configured planner for this drive.
         """
+        plan_cfg = planner or self.config.planner
         tol = 0.6 * self.forward if tolerance is None else tolerance
         collisions = idle = 0
         while True:
@@ -203,12 +206,12 @@ class FrontierExplorer:
             if math.dist(self.xy, goal_xy) <= tol:
                 return Status.ARRIVED
             grid = self.grid()
-            cm = self.costmap(grid)
+            cm = self.costmap(grid, plan_cfg)
             aim = _snap_goal(cm, goal_xy, self.config.goal_snap)
             if aim is None:
                 return Status.BLOCKED
             try:
-                path = plan_path(grid, self.xy, aim, self.config.planner, cm)
+                path = plan_path(grid, self.xy, aim, plan_cfg, cm)
             except CapNavError:
                 return Status.BLOCKED
             before = self.steps
