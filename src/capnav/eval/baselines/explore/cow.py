@@ -2,7 +2,9 @@
 
 CoW explores with a frontier policy that ignores the goal, localises the goal in every view
 (CLIP saliency) and drives to it once found. Here the localiser is the shared detector's labels
-matched to the goal text (``goal_match``), and the frontier chosen is the nearest by path length.
+matched to the goal text (``goal_match``; a sighting needs enough confidence and must not be
+outvoted by other labels seen at the same place), lifted to 3D with depth; the frontier chosen is
+the nearest by path cost on an occupancy map built online from the agent's own depth.
 """
 
 from __future__ import annotations

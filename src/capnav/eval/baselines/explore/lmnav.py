@@ -4,10 +4,11 @@ LM-Nav parses landmarks out of an instruction with an LLM, scores every node ima
 topological memory against each landmark with CLIP, searches the graph for the best route and
 drives it with a learned local policy. Here the landmark is the goal text (one landmark per
 subgoal), a node's match is the best similarity between the goal and the labels the shared
-detector saw from that node times that detection's confidence (a clearer view scores higher, as
-with CLIP), the route is Dijkstra on the graph of ``topo_graph``, and the local policy is the
-shared A* planner between consecutive nodes on the stream's own depth-derived occupancy. The
-agent stops at the node, not at the object: LM-Nav never localises the landmark metrically.
+detector saw from that node times that detection's confidence, less a cost per metre between node
+and landmark (a clear, close view scores higher, as with CLIP); the route is Dijkstra on the graph
+of ``topo_graph``, and the local policy is the shared A* planner between consecutive nodes on the
+stream's own depth-derived occupancy. The agent stops at the node, not at the object: LM-Nav
+never localises the landmark metrically.
 """
 
 from __future__ import annotations
