@@ -2,8 +2,9 @@
 
 The exploration stream is regenerated deterministically from (scene seed, settings) when needed;
 the prior map (tracked objects, captions, embeddings, voxels, occupancy) is built ONCE per apartment
-and cached in the run folder, keyed by the settings that made it, so every map-based method of a
-run, and every rerun, uses the identical map.
+and cached in the run folder, keyed by the settings that made it and by the apartment's manifest,
+so every map-based method of a run, and every rerun, uses the identical map. (A change to the
+mapping code itself is not detected: delete ``scenes/*/map.capnav`` after one.)
 """
 
 from __future__ import annotations
@@ -121,7 +122,10 @@ def _cached_map(assets: SceneAssets) -> CapNavMap:
     from capnav.io.mapfile import load_map, save_map
 
     path = assets.folder / MAP_FILE
-    key = assets.config.map_key(assets.scene_seed, assets.seed)
+    # the apartment itself is part of the key: a changed simulator makes a different apartment
+    # from the same seed, and a map of the old one must not be scored against the new truth
+    scene = hashlib.sha256(assets.sim.manifest.model_dump_json().encode()).hexdigest()[:16]
+    key = f"{assets.config.map_key(assets.scene_seed, assets.seed)}-{scene}"
     if path.is_file():
         try:
             cmap = load_map(path)
