@@ -78,10 +78,10 @@ def generate_scene_episodes(assets: SceneAssets, config: EvalConfig, protocol: s
     return description_episodes(assets.truth, describe, rng, config.episode_config())
 
 
-def task_key(task: SceneTask) -> str:
-    """Identity of a task's results: settings, apartment and given episodes (not the progress flag)."""
-    blob = json.dumps({"config": asdict(task.config), "scene": task.scene_seed, "episodes": task.episodes},
-                      sort_keys=True, default=str)
+def task_key(task: SceneTask, manifest_json: str = "") -> str:
+    """Identity of a task's results: settings, apartment (its manifest) and given episodes."""
+    blob = json.dumps({"config": asdict(task.config), "scene": task.scene_seed, "episodes": task.episodes,
+                       "manifest": hashlib.sha256(manifest_json.encode()).hexdigest()}, sort_keys=True, default=str)
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
@@ -89,21 +89,22 @@ def run_scene(task: SceneTask) -> dict[str, Any]:
     """Run one apartment; returns {"scene_seed", "episodes", "records", "timings", "failures", "map"}.
 
     The result is saved in the run folder as soon as the apartment is done; a rerun of the same
-    task (same settings) returns it instead of recomputing, so an interrupted run resumes."""
+    task (same settings, same apartment) returns it instead of recomputing, so an interrupted run
+    resumes."""
     cfg = task.config
     out = Path(task.out)
     folder = out / "scenes" / str(task.scene_seed)
-    key = task_key(task)
-    saved = folder / RESULT_FILE
-    if saved.is_file():
-        try:
-            old = json.loads(saved.read_text())
-            if old.get("task_key") == key:
-                return dict(old)
-        except (OSError, json.JSONDecodeError):
-            pass  # unreadable: recompute
     assets = open_scene(task.scene_seed, cfg.seed, cfg.pipeline, folder)
     try:
+        key = task_key(task, assets.sim.manifest.model_dump_json())
+        saved = folder / RESULT_FILE
+        if saved.is_file():
+            try:
+                old = json.loads(saved.read_text())
+                if old.get("task_key") == key:
+                    return dict(old)
+            except (OSError, json.JSONDecodeError):
+                pass  # unreadable: recompute
         res = _run(task, cfg, out, assets)
     finally:
         assets.sim.close()
