@@ -63,9 +63,14 @@ def build_costmap(occ: OccupancyGrid, config: PlannerConfig | None = None) -> Co
     return Costmap(OccupancyGrid(occ.spec, occ.cells.copy()), w)
 
 
-def mark_blocked(costmap: Costmap, xy: NDArray[np.floating], radius: float, config: PlannerConfig) -> int:
+def mark_blocked(costmap: Costmap, xy: NDArray[np.floating], radius: float, config: PlannerConfig,
+                 robot_xy: NDArray[np.floating] | None = None) -> int:
     """Record an obstacle found by contact: a disk at ``xy`` becomes OCCUPIED, and its inflation
-    becomes untraversable. Returns the number of newly blocked cells."""
+    becomes untraversable. Returns the number of newly blocked cells.
+
+    The disk the robot stands on (``robot_xy``, robot radius) is never marked: the robot is
+    physically there, so it is free, and marking it would leave the robot "inside an obstacle".
+    """
     spec = costmap.spec
     rc = spec.to_cell(np.asarray(xy, dtype=np.float64))
     reach = radius + config.inflation
@@ -77,9 +82,12 @@ def mark_blocked(costmap: Costmap, xy: NDArray[np.floating], radius: float, conf
     rr, cc = np.mgrid[r0:r1, c0:c1]
     centres = spec.to_world(np.stack([rr, cc], axis=-1))
     d = np.linalg.norm(centres - np.asarray(xy, dtype=np.float64), axis=-1)
-    costmap.occ.cells[r0:r1, c0:c1][d <= radius] = OCCUPIED
+    keep = np.zeros(d.shape, dtype=bool)
+    if robot_xy is not None:
+        keep = np.linalg.norm(centres - np.asarray(robot_xy, dtype=np.float64), axis=-1) <= config.robot_radius
+    costmap.occ.cells[r0:r1, c0:c1][(d <= radius) & ~keep] = OCCUPIED
     win = costmap.weights[r0:r1, c0:c1]
-    newly = (d <= reach) & np.isfinite(win)
+    newly = (d <= reach) & np.isfinite(win) & ~keep
     win[newly] = np.inf
     return int(newly.sum())
 

@@ -106,7 +106,7 @@ def navigate_to(agent: StepAgent, occ: OccupancyGrid, target_footprint: NDArray[
             _face(agent, goal.yaw, log)
             reason = goal.reason
             break
-        n = levels.mark(blocked_at)
+        n = levels.mark(blocked_at, log.xy())
         here = np.asarray(log.xy()).reshape(1, 2)
         if footprint_distance(here, fp)[0] <= cfg.reach - cfg.goal_margin:
             _face(agent, goal.yaw, log)
@@ -176,7 +176,7 @@ class _Levels:
         assert error is not None
         raise error
 
-    def mark(self, xy: NDArray[np.float64]) -> int:
+    def mark(self, xy: NDArray[np.float64], robot_xy: tuple[float, float]) -> int:
         """Block a contact on every level, grown by the full robot radius + margin even on relaxed
         levels (a contact is proof the relaxation was too optimistic there). When that adds
         nothing the obstacle must be larger than the mark: grow it, so a replan never repeats."""
@@ -184,7 +184,7 @@ class _Levels:
         n = 0
         for _ in range(4):
             for cm in self.maps.values():
-                n = max(n, mark_blocked(cm, xy, radius, self.cfgs[0]))
+                n = max(n, mark_blocked(cm, xy, radius, self.cfgs[0], np.asarray(robot_xy)))
             if n:
                 break
             radius *= 2
