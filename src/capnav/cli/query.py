@@ -28,7 +28,8 @@ def register(app: typer.Typer) -> None:
         robot: str | None = typer.Option(None, "--robot", help="robot position X,Y in metres"),
         as_json: bool = typer.Option(False, "--json", help="print the result as JSON"),
         verifier: str = typer.Option("offline", help="offline | none | gemini | openai | hf-local"),
-        no_heuristic: bool = typer.Option(False, help="ablation: no attribute heuristic (pure semantic)"),
+        heuristic: bool = typer.Option(True, "--heuristic/--no-heuristic",
+                                       help="attribute heuristic; --no-heuristic is the paper's ablation"),
         embedder: str = typer.Option("auto", help="auto (the map's default model) or a backend name"),
         embedder_path: Path | None = typer.Option(None, help="local model folder for non-default embedders"),
     ) -> None:
@@ -52,7 +53,7 @@ def register(app: typer.Typer) -> None:
             emb = create_embedder("minilm")
         else:
             emb = create_embedder(embedder, **({"path": embedder_path} if embedder_path is not None else {}))
-        cfg = RetrievalConfig(use_verifier=verifier != "none", use_attribute_heuristic=not no_heuristic)
+        cfg = RetrievalConfig(use_verifier=verifier != "none", use_attribute_heuristic=heuristic)
         res: QueryResult = Retriever(cmap, emb, create_verifier(verifier), cfg).query(instruction, robot_xy=xy)
         if as_json:
             typer.echo(json.dumps(res.to_dict(), indent=2))
