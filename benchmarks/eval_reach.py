@@ -23,8 +23,9 @@ from typing import Any
 
 import numpy as np
 
+from capnav.core.footprint import footprint_distance
 from capnav.core.grid import FREE, OccupancyGrid
-from capnav.eval.success import SUCCESS_RADIUS_M, footprint_distance
+from capnav.eval.success import SUCCESS_RADIUS_M
 from capnav.planning import PlannerConfig, build_costmap, navigate_to
 
 TARGET = {"truth": 0.99, "mapped": 0.95}

@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from capnav.core.footprint import footprint_distance
 from capnav.core.grid import GridSpec
 from capnav.eval.baselines.vlmaps import VlmapsStyle, goal_regions, region_polygon, topdown_features
 from capnav.eval.episode_runner import retrieval_correct
 from capnav.eval.generate import SceneTruth
 from capnav.eval.methods.words import category_in_text
-from capnav.eval.success import footprint_distance
 
 
 def test_category_in_text() -> None:

@@ -5,9 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from capnav.core.footprint import footprint_distance
 from capnav.core.grid import GridSpec
 from capnav.eval.geodesic import distance_field
-from capnav.eval.success import distance_to_instances, footprint_distance, is_success
+from capnav.eval.success import distance_to_instances, is_success
 
 SQUARE = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]])
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from capnav.core.errors import InputError
+from capnav.core.footprint import footprint_distance
 from capnav.core.grid import FREE, OccupancyGrid
-from capnav.eval.success import footprint_distance
 from capnav.planning import PlannerConfig, build_costmap, navigate_to
 from capnav.sim import Simulator
 

@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from capnav.cli import app
 from capnav.core.errors import InputError
-from capnav.eval.success import footprint_distance
+from capnav.core.footprint import footprint_distance
 
 SCENE = 2
 pytestmark = pytest.mark.slow  # explores, maps and captions a (small) apartment first

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from capnav.core.errors import InputError, NotFoundError
+from capnav.core.footprint import footprint_distance
 from capnav.core.grid import OCCUPIED, UNKNOWN, GridSpec, OccupancyGrid
-from capnav.eval.success import footprint_distance
 from capnav.planning import PlannerConfig, build_costmap, plan_path, select_goal
 
 RES = 0.05

@@ -17,8 +17,9 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from capnav.core.errors import InputError
+from capnav.core.footprint import footprint_distance
 from capnav.core.grid import GridSpec
-from capnav.eval.success import SUCCESS_RADIUS_M, footprint_distance
+from capnav.eval.success import SUCCESS_RADIUS_M
 
 
 @dataclass

@@ -7,8 +7,8 @@ from typing import Any
 
 import numpy as np
 
+from capnav.core.footprint import footprint_distance
 from capnav.eval.metrics import SubgoalRecord
-from capnav.eval.success import footprint_distance
 
 
 def draw_failure(r: SubgoalRecord, assets: Any, cmap: Any, out_png: Path) -> Path:

@@ -16,8 +16,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.core.errors import CapNavError
+from capnav.core.footprint import footprint_distance
 from capnav.core.grid import OccupancyGrid
-from capnav.eval.success import footprint_distance
 from capnav.planning.config import PlannerConfig
 from capnav.planning.costmap import Costmap, build_costmap, mark_blocked
 from capnav.planning.goal import GoalPose, check_footprint, select_goal

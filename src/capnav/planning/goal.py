@@ -14,8 +14,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.core.errors import InputError, NotFoundError
+from capnav.core.footprint import footprint_distance
 from capnav.core.grid import OccupancyGrid
-from capnav.eval.success import footprint_distance
 from capnav.planning.config import PlannerConfig
 from capnav.planning.costmap import Costmap, build_costmap, locate_start
 from capnav.planning.search import cost_field

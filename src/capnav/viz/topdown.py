@@ -122,7 +122,7 @@ def _draw_reach(ax: Any, fp: NDArray[np.float64], reach: float) -> None:
     lo, hi = fp.min(axis=0) - reach - 0.1, fp.max(axis=0) + reach + 0.1
     xs, ys = np.linspace(lo[0], hi[0], 120), np.linspace(lo[1], hi[1], 120)
     gx, gy = np.meshgrid(xs, ys)
-    from capnav.eval.success import footprint_distance
+    from capnav.core.footprint import footprint_distance
 
     d = footprint_distance(np.stack([gx.ravel(), gy.ravel()], axis=1), fp).reshape(gx.shape)
     ax.contour(gx, gy, d, levels=[reach], colors=[CHOSEN], linewidths=0.9, linestyles=":")
