@@ -8,7 +8,6 @@ protocol). Loading validates everything and fails with one clear message.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Literal
@@ -18,6 +17,7 @@ from pydantic import BaseModel, Field, ValidationError, field_validator, model_v
 from capnav.core.atomic import write_text
 from capnav.core.categories import BY_NAME, NAMES
 from capnav.core.errors import DatasetError, InputError
+from capnav.core.jsonfile import read_json_object
 
 EPISODES_FORMAT: Literal["capnav-episodes"] = "capnav-episodes"
 EPISODES_VERSION = 1
@@ -94,14 +94,7 @@ class EpisodeSet(BaseModel):
     def load(cls, path: str | Path) -> EpisodeSet:
         """Load and validate; any problem is a ``DatasetError`` naming the file and the field."""
         p = Path(path)
-        try:
-            data = json.loads(p.read_text())
-        except FileNotFoundError:
-            raise DatasetError(f"episode file not found: {p}") from None
-        except (json.JSONDecodeError, UnicodeDecodeError) as e:
-            raise DatasetError(f"episode file {p} is not valid JSON: {e}") from None
-        if not isinstance(data, dict):
-            raise DatasetError(f"episode file {p} must hold a JSON object, got {type(data).__name__}")
+        data = read_json_object(p, "episode file")
         if data.get("format") != EPISODES_FORMAT:
             raise DatasetError(f"{p} is not a CapNav episode file (format {data.get('format')!r})")
         if data.get("version") != EPISODES_VERSION:

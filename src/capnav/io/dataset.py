@@ -31,6 +31,7 @@ from capnav.core.atomic import write_bytes, write_json, write_text
 from capnav.core.errors import DatasetError, FrameError
 from capnav.core.frame import Frame
 from capnav.core.geometry import Intrinsics, check_pose
+from capnav.core.jsonfile import read_json_object
 
 FORMAT = "capnav-rgbd"
 FORMAT_VERSION = 1
@@ -176,16 +177,7 @@ class DatasetReader:
             raise DatasetError(f"{self.path}: meta.json lists {n} frames but poses.txt has {len(self.poses)}")
 
     def _json(self, name: str) -> dict[str, Any]:
-        p = self.path / name
-        try:
-            data = json.loads(p.read_text())
-        except FileNotFoundError:
-            raise DatasetError(f"{self.path}: missing {name}") from None
-        except (json.JSONDecodeError, UnicodeDecodeError) as e:
-            raise DatasetError(f"{p} is not valid JSON: {e}") from None
-        if not isinstance(data, dict):
-            raise DatasetError(f"{p} must hold a JSON object")
-        return data
+        return read_json_object(self.path / name, f"dataset file {name}")
 
     def _poses(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         p = self.path / "poses.txt"

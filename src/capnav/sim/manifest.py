@@ -6,13 +6,13 @@ The mapping, captioning and retrieval pipeline never reads it. Versioned; saved 
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from pydantic import BaseModel, Field, ValidationError
 
 from capnav.core.atomic import write_text
 from capnav.core.errors import DatasetError
+from capnav.core.jsonfile import read_json_object
 
 MANIFEST_VERSION = 1
 
@@ -76,12 +76,7 @@ class SceneManifest(BaseModel):
     @classmethod
     def load(cls, path: str | Path) -> SceneManifest:
         p = Path(path)
-        try:
-            data = json.loads(p.read_text())
-        except FileNotFoundError:
-            raise DatasetError(f"manifest not found: {p}") from None
-        except json.JSONDecodeError as e:
-            raise DatasetError(f"manifest {p} is not valid JSON: {e}") from None
+        data = read_json_object(p, "manifest")
         if data.get("version") != MANIFEST_VERSION:
             raise DatasetError(f"manifest {p} has version {data.get('version')}, expected {MANIFEST_VERSION}")
         try:
