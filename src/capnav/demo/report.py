@@ -27,7 +27,9 @@ class ReportItem:
     reason: str
     runners_up: list[str] = field(default_factory=list)
     reached: bool | None = None  # the agent stopped within the reach radius of the chosen object
-    correct: bool | None = None  # judged against the simulator's truth (None for user instructions)
+    correct: bool | None = None  # stopped within 1 m of a meant instance, by the simulator's truth (None: user text)
+    right_object: bool | None = None  # the chosen map object lies on a meant instance (truth)
+    truth_distance: float | None = None  # m from the stop to the nearest meant instance (truth)
     path_length: float | None = None
     nav_reason: str = ""
     view_png: str | None = None  # path relative to the report folder
@@ -43,12 +45,16 @@ class Report:
     overview_png: str | None = None
 
 
-def _verdict(it: ReportItem) -> str:
+def verdict(it: ReportItem) -> str:
     if not it.found:
         return "not found" + (" (correct)" if it.correct else " (wrong)" if it.correct is False else "")
+    if it.right_object is False:
+        return "wrong object"
+    if it.correct is False and it.truth_distance is not None:
+        return f"right object, but stopped {it.truth_distance:.2f} m from it (success needs 1 m)"
     parts = ["reached" if it.reached else "not reached"]
-    if it.correct is not None:
-        parts.append("right object" if it.correct else "wrong object")
+    if it.right_object:
+        parts.append("right object")
     return ", ".join(parts)
 
 
@@ -58,7 +64,7 @@ def write_markdown(report: Report, path: Path) -> None:
     if report.overview_png:
         lines += [f"![apartment]({report.overview_png})", ""]
     for i, it in enumerate(report.items, 1):
-        lines += [f"## {i}. \"{it.instruction}\"", "", f"*{it.kind}* — **{_verdict(it)}**", ""]
+        lines += [f"## {i}. \"{it.instruction}\"", "", f"*{it.kind}* — **{verdict(it)}**", ""]
         if it.found:
             lines += [f"- chosen: object {it.chosen_id} ({it.chosen_label}), score {it.score:.3f}",
                       f"- caption: {it.caption}"]
@@ -92,7 +98,7 @@ def write_html(report: Report, path: Path) -> None:
         good = (it.correct is not False) and (it.reached is not False)
         parts.append(f"<div class='item'><h2>{i}. &ldquo;{e(it.instruction)}&rdquo;</h2>")
         css = "ok" if good else "bad"
-        parts.append(f"<p><i>{e(it.kind)}</i> &mdash; <b class='{css}'>{e(_verdict(it))}</b></p><ul>")
+        parts.append(f"<p><i>{e(it.kind)}</i> &mdash; <b class='{css}'>{e(verdict(it))}</b></p><ul>")
         if it.found:
             parts.append(f"<li>chosen: object {it.chosen_id} ({e(str(it.chosen_label))}), score {it.score:.3f}</li>")
             parts.append(f"<li>caption: <q>{e(str(it.caption))}</q></li>")

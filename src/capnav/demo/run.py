@@ -18,7 +18,7 @@ from rich.console import Console
 
 from capnav.core.atomic import write_bytes, write_json
 from capnav.core.errors import CapNavError, InputError
-from capnav.demo.report import Report, ReportItem, write_html, write_markdown
+from capnav.demo.report import Report, ReportItem, verdict, write_html, write_markdown
 from capnav.eval.pipeline import PipelineConfig, open_scene
 from capnav.eval.success import SUCCESS_RADIUS_M, distance_to_instances
 from capnav.mapping.objects import MapObject
@@ -120,9 +120,7 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
         text, kind, targets = nxt
         it = _answer(len(items) + 1, text, kind, targets, retriever, agent, cmap, assets, pcfg_plan, out)
         items.append(it)
-        con.print(f"     {len(items)}. \\[{kind}] {text!r}: {it.chosen_label or 'not found'}"
-                  + (f" -> {'reached' if it.reached else 'not reached'}" if it.found else "")
-                  + ("" if it.correct is None else f" ({'right' if it.correct else 'wrong'})"))
+        con.print(f"     {len(items)}. \\[{kind}] {text!r}: {it.chosen_label or '-'}: {verdict(it)}")
 
     con.print("[bold]4/4[/] writing the report")
     timings["total"] = time.perf_counter() - t0
@@ -160,7 +158,13 @@ def _answer(k: int, text: str, kind: str, targets: list[int], retriever: Retriev
         item.correct = not q.found
     elif targets:  # right only when the agent stops within reach of an instance the instruction meant
         fps = [assets.truth.footprints[t] for t in targets]
-        item.correct = nav is not None and distance_to_instances(nav.final_pose[:2], fps) <= SUCCESS_RADIUS_M
+        if obj is not None:  # the chosen object is right when the nearest true instance to it is meant
+            near = min(assets.truth.footprints, key=lambda i: distance_to_instances(
+                obj.position[:2], [assets.truth.footprints[i]]))
+            item.right_object = near in targets
+        if nav is not None:
+            item.truth_distance = distance_to_instances(nav.final_pose[:2], fps)
+        item.correct = item.truth_distance is not None and item.truth_distance <= SUCCESS_RADIUS_M
     if obj is not None and (view := _png(obj)):
         item.view_png = f"images/{k:02d}_view.png"
         write_bytes(out / item.view_png, view)
