@@ -60,6 +60,24 @@ def lookup(table_keys: NDArray[np.int64], table_vals: NDArray[np.int32], keys: N
 
 
 @nb.njit(cache=True, nogil=True)
+def _claim(table_keys: NDArray[np.int64], table_vals: NDArray[np.int32], shift: np.uint64,
+           voxel_keys: NDArray[np.int64], weights: NDArray[np.float64], colors: NDArray[np.float32],
+           features: NDArray[np.float32], n: int, key: np.int64) -> tuple[int, int]:
+    """The slot of voxel ``key`` and the new voxel count: an unseen key gets slot ``n`` with zero
+    weight, colour and feature, so its first update is exactly its first observation."""
+    h = _slot_of(table_keys, key, shift)
+    if table_keys[h] != -1:
+        return int(table_vals[h]), n
+    table_keys[h] = key
+    table_vals[h] = n
+    voxel_keys[n] = key
+    weights[n] = 0.0
+    colors[n, :] = 0.0
+    features[n, :] = 0.0
+    return n, n + 1
+
+
+@nb.njit(cache=True, nogil=True)
 def fuse(table_keys: NDArray[np.int64], table_vals: NDArray[np.int32], shift: np.uint64,
          voxel_keys: NDArray[np.int64], weights: NDArray[np.float64], colors: NDArray[np.float32],
          features: NDArray[np.float32], n: int, keys: NDArray[np.int64], alpha: NDArray[np.float32],
@@ -72,21 +90,7 @@ def fuse(table_keys: NDArray[np.int64], table_vals: NDArray[np.int32], shift: np
     """
     d = features.shape[1]
     for p in range(keys.shape[0]):
-        key = keys[p]
-        h = _slot_of(table_keys, key, shift)
-        if table_keys[h] == -1:
-            table_keys[h] = key
-            table_vals[h] = n
-            s = n
-            voxel_keys[s] = key
-            weights[s] = 0.0
-            for c in range(3):
-                colors[s, c] = 0.0
-            for j in range(d):
-                features[s, j] = 0.0
-            n += 1
-        else:
-            s = table_vals[h]
+        s, n = _claim(table_keys, table_vals, shift, voxel_keys, weights, colors, features, n, keys[p])
         a = np.float64(alpha[p])
         w_new = weights[s] + a
         r = np.float32(a / w_new)
@@ -129,20 +133,7 @@ def fuse_image(table_keys: NDArray[np.int64], table_vals: NDArray[np.int32], shi
             j = np.int64(np.floor((wy - origin[1]) / res)) + off
             k = np.int64(np.floor((wz - origin[2]) / res)) + off
             key = (i << 42) | (j << 21) | k
-            hh = _slot_of(table_keys, key, shift)
-            if table_keys[hh] == -1:
-                table_keys[hh] = key
-                table_vals[hh] = n
-                s = n
-                voxel_keys[s] = key
-                weights[s] = 0.0
-                for c in range(3):
-                    colors[s, c] = 0.0
-                for jj in range(d):
-                    features[s, jj] = 0.0
-                n += 1
-            else:
-                s = table_vals[hh]
+            s, n = _claim(table_keys, table_vals, shift, voxel_keys, weights, colors, features, n, key)
             w_new = weights[s] + a
             r = np.float32(a / w_new)
             for c in range(3):
