@@ -30,7 +30,11 @@ class Agent:
         if not all(math.isfinite(v) for v in (x, y, yaw)):
             raise InputError(f"agent pose must be finite, got ({x}, {y}, {yaw})")
         if sim.collides(x, y):
-            raise InputError(f"cannot spawn the agent at ({x:.2f}, {y:.2f}): it would overlap an obstacle")
+            x0, y0, x1, y1 = sim.manifest.bounds
+            where = ("it is outside the apartment, which spans "
+                     f"x in [{x0:.2f}, {x1:.2f}], y in [{y0:.2f}, {y1:.2f}]"
+                     if not (x0 < x < x1 and y0 < y < y1) else "it would overlap a wall or furniture")
+            raise InputError(f"cannot spawn the agent at ({x:.2f}, {y:.2f}): {where}")
         self.sim = sim
         self.cfg = sim.config.agent
         self.x, self.y, self.yaw = float(x), float(y), _wrap(float(yaw))
