@@ -101,7 +101,11 @@ def render(summaries: Sequence[Summary], config: Mapping[str, Any],
     out += details(summaries)
     if notes:
         out += ["", "## Methods: what each one is, and how it differs from its original", ""]
-        out += [f"- **{name}**: {' '.join(text.split())}" for name, text in notes.items()]
+        # Methods implemented in one module (CapNav and its ablations) share a note: say it once.
+        by_text: dict[str, list[str]] = {}
+        for name, text in notes.items():
+            by_text.setdefault(" ".join(text.split()), []).append(name)
+        out += [f"- **{' / '.join(names)}**: {text}" for text, names in by_text.items()]
     if timings:
         out += ["", "## Where the time went (s, summed over workers)", "",
                 "| Stage | Seconds |", "|---|---:|"]
