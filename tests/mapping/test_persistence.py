@@ -131,3 +131,18 @@ def test_recheck_moves_a_neighbours_detection_to_its_own_object() -> None:
     assert 9 not in mem.objects[a].frames and 9 in mem.objects[b].frames
     # the next frame sees chair A again: consistent with b? no -> back to a
     assert mem.observe(t, _det(chair), obs, 10, h_min=2, busy=set()) == a
+
+
+def test_footprint_ignores_stray_points() -> None:
+    """A few stray points (mask edges on the floor) must not stretch the footprint that goals are
+    chosen against: the hull stays inside the robust extent."""
+    from capnav.mapping import ObjectMemory
+
+    rng = np.random.default_rng(2)
+    shelf = rng.uniform([0.0, 0.0, 0.0], [0.4, 1.0, 2.0], (600, 3))
+    stray = np.array([[0.9, 0.5, 0.02], [0.8, 0.2, 0.03]])  # 2 points 0.4-0.5 m in front of it
+    mem = ObjectMemory()
+    _feed(mem, 1, np.vstack([shelf, stray]), range(0, 3))
+    (obj,) = mem.export()
+    assert obj.footprint[:, 0].max() <= obj.extent_max[0] + 1e-9 < 0.45
+    assert obj.footprint[:, 1].max() > 0.95  # the real extent is kept

@@ -300,7 +300,11 @@ class ObjectMemory:
         q = self.config.extent_percentile
         lo = np.percentile(p, q, axis=0)
         hi = np.percentile(p, 100.0 - q, axis=0)
-        fp = footprint(p[:, :2])
+        # The footprint is the hull of the points inside the robust extent: a few stray points
+        # (mask edges on the floor or a neighbour) would otherwise stretch the hull, and goals
+        # picked at reach distance from it would end up out of reach of the real object.
+        inside = np.all((p[:, :2] >= lo[:2]) & (p[:, :2] <= hi[:2]), axis=1)
+        fp = footprint(p[inside, :2] if inside.sum() >= 3 else p[:, :2])
         label = obj.label
         cat = BY_NAME.get(label)
         mo = MapObject(
