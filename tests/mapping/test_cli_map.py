@@ -44,6 +44,9 @@ def test_map_and_eval(dataset: Path, tmp_path: Path) -> None:
     r = CliRunner().invoke(app, ["map", str(dataset), "-o", str(out), "--noise", "oracle", "--no-progress"])
     assert r.exit_code == 0, r.output
     assert out.is_file() and "objects" in r.output
+    from capnav.io.mapfile import load_map
+
+    assert "scene_seed" not in load_map(out).meta  # not a simulator recording: no apartment to name
     js = tmp_path / "q.json"
     r = CliRunner().invoke(app, ["map-eval", str(out), "--manifest", str(dataset / "manifest.json"),
                                  "--json", str(js)])
@@ -81,3 +84,18 @@ def test_errors_are_one_line_exit_2(tmp_path: Path) -> None:
     r = subprocess.run([sys.executable, "-m", "capnav.cli", "map", str(tmp_path / "nope"), "-o", str(broken)],
                        capture_output=True, text=True)
     assert r.returncode == 2 and "dataset folder not found" in r.stderr
+
+
+def test_simulator_seed_travels_with_the_map(tmp_path: Path) -> None:
+    """A map of a `capnav sim` recording names its apartment, so `capnav navigate` needs no --scene."""
+    from capnav.io.mapfile import load_map
+
+    root = tmp_path / "ds"
+    frames = orbit(6)
+    with DatasetWriter(root, frames[0].K, {"source": "capnav.sim", "seed": 7}) as w:
+        for f in frames:
+            w.write(f)
+    out = tmp_path / "m.capnav"
+    r = CliRunner().invoke(app, ["map", str(root), "-o", str(out), "--noise", "oracle", "--no-progress"])
+    assert r.exit_code == 0, r.output
+    assert load_map(out).meta["scene_seed"] == 7

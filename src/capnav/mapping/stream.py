@@ -31,4 +31,7 @@ def map_dataset(path: str | Path | DatasetReader, detector: Detector, encoder: D
             continue
         mapper.integrate(frame)
     meta: dict[str, Any] = {"dataset": str(Path(path).resolve()), "dataset_frames": len(reader)}
+    producer = reader.meta.get("meta") or {}
+    if producer.get("source") == "capnav.sim" and isinstance(producer.get("seed"), int):
+        meta["scene_seed"] = producer["seed"]  # lets `capnav navigate` drive in the same apartment
     return mapper.finish(meta)
