@@ -51,7 +51,8 @@ def _line(description: str, done: int, total: int | None, elapsed: float) -> str
     rate = done / elapsed if elapsed > 0 else 0.0
     of = f"/{total}" if total else ""
     eta = f", about {(total - done) / rate:.0f} s left" if total and rate > 0 and done < total else ""
-    return f"{description}: {done}{of} in {elapsed:.0f} s ({rate:.1f}/s{eta})"
+    pace = f"{rate:.1f}/s" if rate >= 1 or done == 0 else f"{elapsed / done:.1f} s each"
+    return f"{description}: {done}{of} in {elapsed:.0f} s ({pace}{eta})"
 
 
 def _len(items: Iterable[object]) -> int | None:
