@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Install CapNav into ./.venv (created if missing). Idempotent.
 #   bash scripts/setup.sh          # runtime: the offline defaults (no PyTorch)
-#   bash scripts/setup.sh --dev    # + test/lint tools and the optional model back-ends the tests exercise
+#   bash scripts/setup.sh --dev    # + test/lint tools, the optional model back-ends and Ray, which the tests exercise
 # Set CAPNAV_VENV to use another environment folder.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,7 +21,7 @@ PIP=("$VENV/bin/python" -m pip install --quiet --disable-pip-version-check)
 if [ "$DEV" = 1 ]; then
   # CPU build of PyTorch first, so that sentence-transformers/transformers do not pull a CUDA build.
   "${PIP[@]}" "torch==2.13.0"
-  "${PIP[@]}" -e ".[dev,bge,vlm,gemini,openai]"
+  "${PIP[@]}" -e ".[dev,bge,vlm,gemini,openai,ray]"
 else
   "${PIP[@]}" -e .
 fi
