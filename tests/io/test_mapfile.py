@@ -5,6 +5,7 @@ from __future__ import annotations
 import hashlib
 import sys
 import zipfile
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -87,30 +88,26 @@ def test_truncated_file(cmap: CapNavMap, tmp_path: Path) -> None:
             load_map(bad)
 
 
+def _edited_copy(src: Path, dst: Path, entry: str, edit: Callable[[bytes], bytes]) -> Path:
+    """A copy of the map file ``src`` whose zip entry ``entry`` went through ``edit``."""
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w") as zout:
+        for info in zin.infolist():
+            data = zin.read(info.filename)
+            zout.writestr(info.filename, edit(data) if info.filename == entry else data)
+    return dst
+
+
 def test_corrupted_entry_is_named(cmap: CapNavMap, tmp_path: Path) -> None:
     p = save_map(cmap, tmp_path / "m.capnav")
-    src = zipfile.ZipFile(p)
-    bad = tmp_path / "bad.capnav"
-    with zipfile.ZipFile(bad, "w") as zf:
-        for info in src.infolist():
-            data = src.read(info.filename)
-            if info.filename == "voxels/weights.npy":
-                data = data[:-8] + b"\x00" * 8
-            zf.writestr(info.filename, data)
+    bad = _edited_copy(p, tmp_path / "bad.capnav", "voxels/weights.npy", lambda d: d[:-8] + b"\x00" * 8)
     with pytest.raises(MapFileError, match=r"voxels/weights\.npy.*checksum"):
         load_map(bad)
 
 
 def test_wrong_version_and_foreign_files(cmap: CapNavMap, tmp_path: Path) -> None:
     p = save_map(cmap, tmp_path / "m.capnav")
-    src = zipfile.ZipFile(p)
-    bad = tmp_path / "v9.capnav"
-    with zipfile.ZipFile(bad, "w") as zf:
-        for info in src.infolist():
-            data = src.read(info.filename)
-            if info.filename == "header.json":
-                data = data.replace(b'"version": 1', b'"version": 9')
-            zf.writestr(info.filename, data)
+    bad = _edited_copy(p, tmp_path / "v9.capnav", "header.json",
+                       lambda d: d.replace(b'"version": 1', b'"version": 9'))
     with pytest.raises(MapFileError, match="version 9"):
         load_map(bad)
     txt = tmp_path / "x.capnav"
