@@ -24,10 +24,10 @@ from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from capnav.core.categories import BY_NAME, NAMES
 from capnav.core.errors import InputError
+from capnav.core.footprint import footprint_distance
 from capnav.language.colors import ciede2000, srgb_to_lab
 from capnav.sim.manifest import ObjectInstance, SceneManifest
 
@@ -87,28 +87,11 @@ def _volume(o: ObjectInstance) -> float:
     return float(np.prod(o.size))
 
 
-def _seg_point_dist(p: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
-    ab = b - a
-    t = float(np.clip(np.dot(p - a, ab) / max(float(np.dot(ab, ab)), 1e-12), 0.0, 1.0))
-    return float(np.linalg.norm(p - (a + t * ab)))
-
-
-def _inside(p: NDArray[np.float64], poly: NDArray[np.float64]) -> bool:
-    """Point in a convex counter-clockwise polygon."""
-    for k in range(len(poly)):
-        a, b = poly[k], poly[(k + 1) % len(poly)]
-        if (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) < -1e-9:
-            return False
-    return True
-
-
 def footprint_gap(a: ObjectInstance, b: ObjectInstance) -> float:
-    """Distance between two convex footprints (0 when they touch or overlap)."""
+    """Distance between two convex footprints (0 when they touch or overlap): the nearest vertex of
+    either to the other polygon."""
     pa, pb = np.asarray(a.footprint, dtype=np.float64), np.asarray(b.footprint, dtype=np.float64)
-    if any(_inside(p, pb) for p in pa) or any(_inside(p, pa) for p in pb):
-        return 0.0
-    d = min(_seg_point_dist(p, pb[k], pb[(k + 1) % len(pb)]) for p in pa for k in range(len(pb)))
-    return min(d, min(_seg_point_dist(p, pa[k], pa[(k + 1) % len(pa)]) for p in pb for k in range(len(pa))))
+    return float(min(footprint_distance(pa, pb).min(), footprint_distance(pb, pa).min()))
 
 
 class InstructionGenerator:
@@ -301,9 +284,7 @@ class InstructionGenerator:
             if np.any(hi <= lo):
                 continue
             p = rng.uniform(lo, hi)
-            if all(not _inside(p, np.asarray(o.footprint)) and
-                   min(_seg_point_dist(p, np.asarray(o.footprint[k]), np.asarray(o.footprint[(k + 1) % 4]))
-                       for k in range(4)) >= clearance for o in objs):
+            if all(footprint_distance(p, np.asarray(o.footprint))[0] >= clearance for o in objs):
                 return float(p[0]), float(p[1])
         raise InputError(f"scene {self.m.seed}: no free robot position found")
 
