@@ -118,6 +118,28 @@ def test_online_map_matches_the_true_layout(sim: Simulator) -> None:
     assert ((mine == OCCUPIED) & (truth == FREE)).sum() / max((mine == OCCUPIED).sum(), 1) < 0.25
 
 
+def test_the_explorer_looks_at_keyframes_and_before_decisions(sim: Simulator) -> None:
+    from capnav.eval.baselines.explore.explorer import FrontierExplorer
+
+    agent = sim.spawn_agent(*sim.random_navigable_point(np.random.default_rng(3)))
+    ex = FrontierExplorer(agent, None, ExplorerConfig())
+    ex.begin(100)
+    ex.observe()
+    for _ in range(6):  # 6 x 30 degrees: a look after every second turn
+        ex.act("turn_left")
+    assert ex.looks == 1 + 3
+    ex.act("turn_left")
+    assert ex.looks == 4 and ex.sync() and ex.looks == 5  # a decision after an unseen turn looks first
+    assert not ex.sync() and ex.looks == 5  # ... but not twice from the same pose
+    every = FrontierExplorer(agent, None, ExplorerConfig(keyframe_turn_deg=0, keyframe_move=0))
+    every.begin(100)
+    for _ in range(4):
+        every.act("turn_right")
+    assert every.looks == 4
+    with pytest.raises(InputError):
+        ExplorerConfig(keyframe_move=-1)
+
+
 def test_frontier_costs_go_around_a_wall() -> None:
     """Frontier path costs come from the planner's cost field: around walls, never through them."""
     spec = GridSpec(0.0, 0.0, 0.1, 40, 40)

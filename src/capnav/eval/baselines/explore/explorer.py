@@ -1,10 +1,13 @@
 """The shared frontier-exploration core: observe, map, pick a frontier, drive there step by step.
 
 Every motion is one discrete agent action (turn or forward step, as in Habitat's object-goal
-task) and is followed by an observation, so the online map and the sightings grow while the agent
-moves, and a ``stop`` predicate can end the search the moment the goal is in view. The budget
-counts actions; running out is a timeout, running out of reachable frontiers means the whole
-reachable space was seen.
+task). The agent looks (renders, maps, detects) at keyframes: once its view has changed enough
+since the last look (a 60 degree turn or 0.5 m; the camera sees 90 degrees), after a collision,
+and before every decision that reads the map. Consecutive 30 degree / 0.25 m views overlap by
+two thirds, and looking is most of the cost of an action, so this halves the work while the map
+and the sightings still grow as the agent moves, and a ``stop`` predicate ends the search at the
+first keyframe that shows the goal. The budget counts actions; running out is a timeout, running
+out of reachable frontiers means the whole reachable space was seen.
 """
 
 from __future__ import annotations
@@ -56,12 +59,16 @@ class ExplorerConfig:
     max_collisions: int = 4  # per drive, before the target is given up
     min_sighting_points: int = 10  # valid depth pixels a detection needs to be lifted
     goal_snap: float = 0.5  # m, a goal inside the inflated obstacles moves to the nearest free cell
+    keyframe_turn_deg: float = 60.0  # look again after turning this much since the last look ...
+    keyframe_move: float = 0.5  # ... or moving this far (m); 0 and 0: look after every action
 
     def __post_init__(self) -> None:
         if self.max_steps is not None and self.max_steps < 1:
             raise InputError(f"max_steps must be >= 1, got {self.max_steps}")
         if self.replan_every < 1 or self.min_frontier_cells < 1 or self.max_collisions < 1:
             raise InputError("replan_every, min_frontier_cells and max_collisions must be >= 1")
+        if self.keyframe_turn_deg < 0 or self.keyframe_move < 0:
+            raise InputError("keyframe_turn_deg and keyframe_move must be >= 0")
 
 
 class FrontierExplorer:
@@ -82,6 +89,8 @@ class FrontierExplorer:
         self.budget = 0
         self.steps = 0
         self.frame: Frame | None = None
+        self.looks = 0  # observations made (the costly part of an action)
+        self._looked_from: tuple[float, float, float] | None = None  # pose of the last observation
         agent_cfg = getattr(agent, "cfg", None) or getattr(agent, "config", None)
         self.turn = math.radians(float(getattr(agent_cfg, "turn_deg", 30.0)))
         self.forward = float(getattr(agent_cfg, "forward_step", 0.25))
@@ -101,24 +110,47 @@ class FrontierExplorer:
         """Look: fuse depth into the map, run the detector, remember the lifted sightings."""
         frame = self.agent.observe()
         self.frame = frame
+        self.looks += 1
+        x, y, yaw = (float(v) for v in self.agent.pose)
+        self._looked_from = (x, y, yaw)
         self.map.update(frame)
-        self.map.mark_free_disk(self.xy)
+        self.map.mark_free_disk((x, y))
         dets = self.detector.detect(frame) if self.detector is not None else []
         self.new_sightings = lift(frame, dets, self.config.min_sighting_points)
         self.sightings.extend(self.new_sightings)
         return self.new_sightings
 
+    def sync(self) -> bool:
+        """Look if the agent moved since the last look (before a decision that reads the map);
+        True if it looked."""
+        if self._looked_from is not None and tuple(float(v) for v in self.agent.pose) == self._looked_from:
+            return False
+        self.observe()
+        return True
+
     def act(self, action: str) -> bool:
-        """One action then one observation; False when a forward step hit something."""
+        """One action, then a look if it is a keyframe; False when a forward step hit something."""
         ok = bool(self.agent.step(action))
         self.budget -= 1
         self.steps += 1
+        x, y, yaw = (float(v) for v in self.agent.pose)
+        self.map.mark_free_disk((x, y))  # driven over, so free, whether or not this is a keyframe
         if not ok:
-            x, y, yaw = (float(v) for v in self.agent.pose)
             r = self.config.planner.robot_radius + 0.06
             self.map.mark_obstacle((x + r * math.cos(yaw), y + r * math.sin(yaw)))
-        self.observe()
+        if not ok or self._is_keyframe(x, y, yaw):
+            self.observe()
+        else:
+            self.new_sightings = []
         return ok
+
+    def _is_keyframe(self, x: float, y: float, yaw: float) -> bool:
+        if self._looked_from is None:
+            return True
+        x0, y0, yaw0 = self._looked_from
+        cfg = self.config
+        return (math.dist((x, y), (x0, y0)) >= cfg.keyframe_move - 1e-9
+                or abs(_wrap(yaw - yaw0)) >= math.radians(cfg.keyframe_turn_deg) - 1e-6)
 
     def look_around(self, stop: StopCheck | None = None) -> Status:
         """A full turn in place, observing at every heading."""
@@ -200,6 +232,8 @@ class FrontierExplorer:
         tol = 0.6 * self.forward if tolerance is None else tolerance
         collisions = idle = 0
         while True:
+            if self.sync() and stop is not None and stop(self):
+                return Status.STOPPED
             if goal_of is not None:
                 g = goal_of()
                 goal_xy = g if g is not None else goal_xy
@@ -275,6 +309,8 @@ class FrontierExplorer:
             if st is not Status.ARRIVED:
                 return st
         while self.budget > 0:
+            if self.sync() and stop(self):
+                return Status.STOPPED
             grid = self.grid()
             fronts = self.frontiers(grid, self.costmap(grid))
             if not fronts:
