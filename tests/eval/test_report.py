@@ -41,3 +41,30 @@ def test_render_tables() -> None:
 def test_paper_row_aliases() -> None:
     assert paper_row("lm-nav") is paper_row("lmnav") is not None
     assert paper_row("category-only") is None
+
+
+def _rec(method: str, success: bool, found: bool, correct: bool | None, reason: str = "", error: str = "",
+         protocol: str = "description"):  # type: ignore[no-untyped-def]
+    from capnav.eval.metrics import SubgoalRecord
+
+    return SubgoalRecord(method=method, protocol=protocol, scene_seed=0, episode_id="e", index=0, text="t",
+                         category="sofa", target_ids=[1], kind="attribute", success=success, distance_to_goal=2.0,
+                         path_length=1.0, shortest_path=1.0, start_xy=(0.0, 0.0), stop_xy=(1.0, 0.0), found=found,
+                         retrieval_correct=correct, query_time_s=0.0, steps=0, reason=reason, error=error)
+
+
+def test_failure_classes_and_their_table() -> None:
+    from capnav.eval.failure_modes import MODES, failure_mode, table
+
+    recs = [_rec("cow", True, True, True), _rec("cow", False, False, None, "timeout: 200 actions"),
+            _rec("cow", False, True, False, "sofa seen"), _rec("cow", False, True, True, "stopped short"),
+            _rec("cow", False, False, None, "not found: nothing left"), _rec("cow", False, True, True, "", "boom"),
+            _rec("lmnav", False, True, None, "timeout on the route")]
+    assert [failure_mode(r) for r in recs] == [None, "timeout", "wrong object", "right object, stopped too far",
+                                               "nothing found", "crashed", "timeout"]
+    lines = table(recs, ["lmnav", "cow"])
+    assert lines[0].count("|") == len(MODES) + 4
+    assert lines[2] == "| description | lmnav | 1 | 1 | 0 | 0 | 0 | 0 |"  # order given: lmnav first
+    assert lines[3] == "| description | cow | 5 | 1 | 1 | 1 | 1 | 1 |"  # the success is not counted
+    md = render([summ("cow", "description", [0.5, 0.0, 0.0, 0.0], 0.2)], {"seed": 0}, records=recs)
+    assert "## Why subgoals failed" in md and "| description | cow | 5 |" in md

@@ -122,7 +122,7 @@ def run_benchmark(config: EvalConfig, out: str | Path, workers: int = 1, ray_add
                                       "summaries": [s.to_dict() for s in summaries],
                                       "maps": {str(r["scene_seed"]): r["map"] for r in results}})
     notes = {m: method_note(m) for m in config.methods}
-    write_text(out / "report.md", render(summaries, meta, _pick_failures(failures), timings, notes))
+    write_text(out / "report.md", render(summaries, meta, _pick_failures(failures), timings, notes, records))
     return BenchmarkResult(out, summaries, records, seconds)
 
 

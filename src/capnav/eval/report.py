@@ -6,7 +6,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from capnav.eval.metrics import Summary
+from capnav.eval import failure_modes
+from capnav.eval.metrics import SubgoalRecord, Summary
 from capnav.eval.paper import PAPER_SETUP, TABLE1, TABLE2
 
 #: Display order of methods in the tables (unknown names follow in the order given).
@@ -74,9 +75,10 @@ def details(summaries: Sequence[Summary]) -> list[str]:
 
 def render(summaries: Sequence[Summary], config: Mapping[str, Any],
            failures: Sequence[Mapping[str, Any]] = (), timings: Mapping[str, float] | None = None,
-           notes: Mapping[str, str] | None = None) -> str:
+           notes: Mapping[str, str] | None = None, records: Sequence[SubgoalRecord] = ()) -> str:
     """The whole report as Markdown. ``failures`` items: method, protocol, episode_id, index, text,
-    reason, distance_to_goal, picture (relative path or empty)."""
+    reason, distance_to_goal, picture (relative path or empty); ``records`` (optional) give the
+    table of failure classes."""
     out = ["# CapNav benchmark report", ""]
     out.append(f"capnav {config.get('version', '?')} (commit {config.get('commit', '?')}), seed {config.get('seed')}, "
                f"{config.get('scenes')} apartments (scene seeds {config.get('scene_seeds')}), "
@@ -99,6 +101,11 @@ def render(summaries: Sequence[Summary], config: Mapping[str, Any],
     out += table1(summaries, "description")
     out += ["", "## Details", ""]
     out += details(summaries)
+    if records:
+        out += ["", "## Why subgoals failed (failed subgoals per class)", "",
+                "Judged by the harness: *wrong object* = the chosen target is not at a goal instance; "
+                "*right object, stopped too far* = it is, but the agent ended more than 1 m away.", ""]
+        out += failure_modes.table(records, ORDER)
     if notes:
         out += ["", "## Methods: what each one is, and how it differs from its original", ""]
         # Methods implemented in one module (CapNav and its ablations) share a note: say it once.
