@@ -1,0 +1,165 @@
+"""Turn an associated recording (TUM folder, ROS bag) into a ``capnav-rgbd`` dataset folder.
+
+Shared by every importer: frame selection (stride, max frames), floor alignment, per-frame checks
+with counted skip reasons, and an all-or-nothing write (the dataset is built in a hidden sibling
+folder and renamed into place only once complete, so an interrupted import leaves nothing behind).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from capnav.core.errors import DatasetError, InputError
+from capnav.core.frame import Frame
+from capnav.core.geometry import Intrinsics
+from capnav.core.progress import track
+from capnav.io.align import Alignment, FloorConfig, floor_alignment
+from capnav.io.assoc import SkipLog
+
+
+@dataclass(frozen=True)
+class PlannedFrame:
+    """An associated (colour, depth, pose) triple of a recording, before its images are read."""
+
+    name: str  # how the user finds it in the recording (colour file, or topic and stamp)
+    timestamp: float
+    T_wc: NDArray[np.float64]  # in the recording's world
+    rgb: Any  # the reader's handle for the colour image
+    depth: Any  # ... and for the depth image
+
+
+class Recording(Protocol):
+    """What an importer reader provides: associated frames, skips so far, intrinsics, image loading."""
+
+    path: Path
+    kind: str
+    K: Intrinsics
+    frames: list[PlannedFrame]
+    skipped: SkipLog
+    meta: dict[str, Any]
+
+    def load_depths(self, frames: list[PlannedFrame]) -> Iterator[tuple[PlannedFrame, NDArray[np.float32]]]: ...
+
+    def load(self, frames: list[PlannedFrame]) -> Iterator[
+        tuple[PlannedFrame, NDArray[np.uint8], NDArray[np.float32]]]: ...
+
+
+@dataclass
+class ImportReport:
+    out: Path
+    kind: str
+    associated: int  # colour frames with depth and pose
+    selected: int  # after --stride / --max-frames
+    written: int
+    skipped: SkipLog
+    alignment: Alignment
+    seconds: float
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    def lines(self) -> list[str]:
+        """Human summary: what was written, how the world was aligned, and every skip reason with examples."""
+        a = self.alignment.info
+        out = [f"{self.out}: {self.written} frames written from a {self.kind} recording "
+               f"({self.associated} associated, {self.selected} selected) in {self.seconds:.1f} s"]
+        if a.get("method") == "floor-ransac":
+            out.append(f"floor aligned (--up {self.alignment.up}): {a['floor_points']} floor points, "
+                       f"rms {100 * a['floor_rms_m']:.1f} cm, {a['tilt_from_up_deg']:.1f} deg from the named up axis, "
+                       f"floor was at {-self.alignment.A[2, 3]:+.3f} m along the fitted normal")
+        else:
+            out.append("world frame kept as recorded (--up none)")
+        for reason, n in self.skipped.counts().items():
+            ex = "; ".join(f"{s.name}" + (f" ({s.detail})" if s.detail else "") for s in self.skipped.examples(reason))
+            out.append(f"skipped {n}: {reason} (e.g. {ex})")
+        return out
+
+
+def select(frames: list[PlannedFrame], stride: int = 1, max_frames: int | None = None) -> list[PlannedFrame]:
+    """Every ``stride``-th associated frame, then the first ``max_frames`` (as ``capnav map --max-frames``)."""
+    if stride < 1:
+        raise InputError(f"--stride must be >= 1, got {stride}")
+    if max_frames is not None and max_frames < 1:
+        raise InputError(f"--max-frames must be >= 1, got {max_frames}")
+    return frames[::stride][:max_frames]
+
+
+def _check_target(out: Path, overwrite: bool) -> None:
+    if out.exists() and not out.is_dir():
+        raise DatasetError(f"{out} exists and is not a folder")
+    if out.is_dir() and any(out.iterdir()):
+        if not overwrite:
+            raise DatasetError(f"{out} is not empty (pass --overwrite to replace it)")
+        if not (out / "meta.json").exists() or not (out / "poses.txt").exists():
+            raise DatasetError(f"{out} is not a capnav-rgbd dataset folder; refusing to replace it")
+
+
+def import_recording(rec: Recording, out: str | Path, up: str = "+z", stride: int = 1,
+                     max_frames: int | None = None, overwrite: bool = False, progress: bool = True,
+                     align_frames: int = 30, floor: FloorConfig | None = None) -> ImportReport:
+    """Write ``rec`` as a ``capnav-rgbd`` folder at ``out`` with every pose aligned (``T_wc' = A @ T_wc``)."""
+    from capnav.io.dataset import DatasetWriter
+
+    t0 = time.monotonic()
+    out = Path(out)
+    _check_target(out, overwrite)
+    frames = select(rec.frames, stride, max_frames)
+    if not frames:
+        counts = ", ".join(f"{n} {r}" for r, n in rec.skipped.counts().items()) or "none in the recording"
+        raise InputError(f"{rec.path}: no frame to import (skipped: {counts})")
+    pick = np.unique(np.round(np.linspace(0, len(frames) - 1, min(align_frames, len(frames)))).astype(int))
+    shape = (rec.K.height, rec.K.width)
+    views = ((d, f.T_wc) for f, d in rec.load_depths([frames[i] for i in pick]) if d.shape == shape)
+    align = floor_alignment(views, rec.K, up, floor)
+
+    skipped = SkipLog(list(rec.skipped.skips))
+    tmp = out.parent / f".{out.name}.importing-{os.getpid()}"
+    shutil.rmtree(tmp, ignore_errors=True)
+    meta: dict[str, Any] = {"source": rec.kind, "recording": str(rec.path), **rec.meta,
+                            "alignment": align.to_meta()}
+    try:
+        w = DatasetWriter(tmp, rec.K, meta, write_gt=False)
+        for f, rgb, depth in track(rec.load(frames), f"importing {rec.path.name}", total=len(frames),
+                                   enabled=progress):
+            if rgb.shape[:2] != shape or depth.shape != shape:
+                skipped.add(f.name, f.timestamp, "bad size",
+                            f"rgb {rgb.shape[1]}x{rgb.shape[0]}, depth {depth.shape[-1]}x{depth.shape[0]}, "
+                            f"intrinsics {shape[1]}x{shape[0]}")
+                continue
+            valid = np.isfinite(depth) & (depth > 0)
+            if not valid.any():
+                skipped.add(f.name, f.timestamp, "no valid depth", "every depth pixel is 0 or non-finite")
+                continue
+            depth = np.where(valid, depth, 0.0).astype(np.float32)
+            w.write(Frame(index=len(w), rgb=rgb, depth=depth, K=rec.K, T_wc=align.A @ f.T_wc, timestamp=f.timestamp))
+        if len(w) == 0:
+            raise InputError(f"{rec.path}: every selected frame was skipped ({skipped.counts()})")
+        w.meta["import"] = {"associated": len(rec.frames), "selected": len(frames), "written": len(w),
+                            "skipped": skipped.counts(),
+                            "skipped_examples": {r: [s.name for s in skipped.examples(r)] for r in skipped.counts()}}
+        w.close()
+        _move_into_place(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return ImportReport(out, rec.kind, len(rec.frames), len(frames), w.meta["import"]["written"], skipped, align,
+                        time.monotonic() - t0, meta)
+
+
+def _move_into_place(tmp: Path, out: Path) -> None:
+    """Rename the finished folder to ``out``; a previous dataset there is removed only afterwards."""
+    old = None
+    if out.exists():
+        old = out.parent / f".{out.name}.replaced-{os.getpid()}"
+        shutil.rmtree(old, ignore_errors=True)
+        os.replace(out, old)
+    os.replace(tmp, out)
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
