@@ -107,13 +107,15 @@ class LMNavMethod:
         expl = (f"node {best_node} (frame {int(g.frame_index[best_node])}) saw a {best_sight.label} "
                 f"(confidence {best_sight.score:.2f}, {best_sight.distance:.1f} m away); score {best_score:.2f}")
         extra = {"node": best_node, "route": route, "landmark_xy": best_sight.xy, "nodes": len(g), "edges": g.n_edges}
+        # The target is where the landmark was seen (what the harness judges as the retrieval);
+        # the agent drives to the node that saw it.
         if status is Status.BUDGET:
-            return SubgoalOutcome(True, f"timeout on the {len(route)}-node route to {expl}", nxy, None, query,
-                                  drv.steps, expl, extra)
+            return SubgoalOutcome(True, f"timeout on the {len(route)}-node route to {expl}", best_sight.xy, None,
+                                  query, drv.steps, expl, extra)
         here = drv.xy
         off = float(np.hypot(here[0] - nxy[0], here[1] - nxy[1]))
         note = "" if off <= 0.5 else f" (stopped {off:.2f} m short of it: {status.value})"
-        return SubgoalOutcome(True, f"drove a {len(route)}-node route to {expl}{note}", nxy, None, query,
+        return SubgoalOutcome(True, f"drove a {len(route)}-node route to {expl}{note}", best_sight.xy, None, query,
                               drv.steps, expl, extra)
 
 
