@@ -2,9 +2,30 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
+from typing import Any
 
 import typer
+
+
+def parse_detector_options(items: list[str]) -> dict[str, Any]:
+    """``KEY=VALUE`` strings to detector kwargs; a VALUE that parses as JSON is used as JSON
+    (numbers, true/false, lists), anything else is the plain string."""
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, raw = item.partition("=")
+        key = key.strip()
+        if not sep or not key.isidentifier():
+            raise typer.BadParameter(f"{item!r} is not KEY=VALUE (e.g. model_path=/models/owlv2)",
+                                     param_hint="--detector-option")
+        if key in out:
+            raise typer.BadParameter(f"{key!r} is given twice", param_hint="--detector-option")
+        try:
+            out[key] = json.loads(raw)
+        except ValueError:
+            out[key] = raw
+    return out
 
 
 def register(app: typer.Typer) -> None:
@@ -15,6 +36,10 @@ def register(app: typer.Typer) -> None:
         detector: str = typer.Option("sim", help="detector backend"),
         noise: str = typer.Option("default", help="sim detector noise: default, hard, oracle"),
         seed: int = typer.Option(0, help="seed of the detector's noise"),
+        detector_option: list[str] = typer.Option(
+            [], "--detector-option", metavar="KEY=VALUE",
+            help="detector setting passed to the backend, repeatable; VALUE is JSON when it parses, else "
+                 "text (owl: model_path=DIR, mask=depth|sam|box, sam_path=DIR, score_threshold=0.1, ...)"),
         encoder: str = typer.Option("label-embedding", help="dense feature encoder backend"),
         embedder: str = typer.Option("minilm", help="text embedder of the label-embedding encoder"),
         max_frames: int | None = typer.Option(None, help="use only the first N frames"),
@@ -24,14 +49,20 @@ def register(app: typer.Typer) -> None:
         """Detect, fuse the semantic voxel map, track objects and write the map file."""
         from rich.console import Console
 
+        from capnav.core.errors import InputError
         from capnav.io.dataset import DatasetReader
         from capnav.io.mapfile import save_map
         from capnav.language import create_embedder
         from capnav.mapping import MapperConfig, map_dataset
         from capnav.perception import create_detector, create_encoder
 
+        options = parse_detector_options(detector_option)
         reader = DatasetReader(dataset)  # fail on a bad folder before loading any model
-        det = create_detector(detector, noise=noise, seed=seed) if detector == "sim" else create_detector(detector)
+        kwargs = {"noise": noise, "seed": seed, **options} if detector == "sim" else options
+        try:
+            det = create_detector(detector, **kwargs)
+        except TypeError as e:  # a backend whose factory does not check its kwargs itself
+            raise InputError(f"detector {detector!r} rejected its options {sorted(options)}: {e}") from None
         enc = create_encoder(encoder, embedder=create_embedder(embedder))
         cfg = MapperConfig(on_bad_frame="raise" if strict else "skip")
         cmap = map_dataset(reader, det, enc, cfg, max_frames=max_frames, progress=progress)

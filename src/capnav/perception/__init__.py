@@ -1,6 +1,7 @@
 """Perception stage: detectors (eq. 9) and dense feature encoders (LSeg's Phi_t), chosen by name."""
 
 from capnav.perception import label_encoder as _label_encoder  # noqa: F401  (registers backends)
+from capnav.perception import owl_detector as _owl_detector  # noqa: F401  (torch/transformers load when built)
 from capnav.perception import sim_detector as _sim_detector  # noqa: F401
 from capnav.perception.base import (
     DETECTORS,
@@ -15,6 +16,7 @@ from capnav.perception.base import (
     validate_detections,
 )
 from capnav.perception.label_encoder import LabelEmbeddingEncoder
+from capnav.perception.owl_detector import OwlDetector
 from capnav.perception.sim_detector import NOISE_PRESETS, SimDetector, SimNoise
 
 __all__ = [
@@ -25,6 +27,7 @@ __all__ = [
     "Detection",
     "Detector",
     "LabelEmbeddingEncoder",
+    "OwlDetector",
     "SimDetector",
     "SimNoise",
     "TextEmbedderLike",
