@@ -33,9 +33,10 @@ def register(app: typer.Typer) -> None:
     def map_cmd(
         dataset: Path = typer.Argument(..., help="dataset folder (capnav-rgbd format)"),
         output: Path = typer.Option(..., "-o", "--output", help="map file to write (e.g. apt0.capnav)"),
-        detector: str = typer.Option("sim", help="detector backend"),
+        detector: str = typer.Option("sim", help="detector backend: sim (simulator recordings only) or owl "
+                                                 "(OWL-ViT / OWLv2 from a local folder, docs/perception.md)"),
         noise: str = typer.Option("default", help="sim detector noise: default, hard, oracle"),
-        seed: int = typer.Option(0, help="seed of the detector's noise"),
+        seed: int = typer.Option(0, help="seed of the sim detector's noise"),
         detector_option: list[str] = typer.Option(
             [], "--detector-option", metavar="KEY=VALUE",
             help="detector setting passed to the backend, repeatable; VALUE is JSON when it parses, else "

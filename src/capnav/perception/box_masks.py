@@ -13,11 +13,11 @@ camera pose is known (``floor_pixels``). Invalid depth (0, non-finite) is never 
 mask: it would not reach a voxel anyway. ``filled_box_mask`` is the plain box.
 
 Measured on boxes equal to the true instance boxes (objects >= 200 px, 160x120), median IoU
-with the true mask: 0.94 on the tests' ray-cast box scenes (36 frames), 0.76 on a
-``capnav sim`` apartment (seed 0, 12 frames; 0.53 with the band alone, no growing and no floor
-removal). The known failure is an occluder in front of the object filling a large part of its
-box: its surface is the nearest strong mode and is taken instead. ``mask="sam"`` of the owl
-detector is the better choice when a SAM folder is at hand.
+with the true mask: 0.98 on the tests' ray-cast box scenes (36 frames; 0.78 with the band
+alone), 0.80 on a ``capnav sim`` apartment (seed 0, 12 frames, 39 objects; 0.53 with the band
+alone, no growing and no floor removal). The known failure is an occluder in front of the
+object filling a large part of its box: its surface is the nearest strong mode and is taken
+instead. ``mask="sam"`` of the owl detector is the better choice when a SAM folder is at hand.
 """
 
 from __future__ import annotations

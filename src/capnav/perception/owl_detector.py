@@ -20,6 +20,7 @@ when ``capnav.perception`` is imported (the runtime install has neither).
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import inspect
 import json
@@ -89,6 +90,7 @@ def batched_nms(boxes: NDArray[np.floating], scores: NDArray[np.floating], class
     return nms(shifted, s, iou_threshold)
 
 
+@functools.cache
 def _torchvision_batched_nms() -> Any:
     """``torchvision.ops.batched_nms`` wrapped for numpy, or None when torchvision is missing or broken."""
     try:
@@ -142,6 +144,17 @@ def _require_folder(path: str | Path, what: str) -> Path:
     return p
 
 
+def _number(name: str, value: Any) -> float:
+    """A finite float option (CLI values arrive as JSON or text), or an ``InputError`` naming it."""
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        out = float("nan")
+    if isinstance(value, bool) or not np.isfinite(out):
+        raise InputError(f"{name} must be a finite number, got {value!r}")
+    return out
+
+
 def _import_backend() -> tuple[Any, Any]:
     try:
         import torch
@@ -160,6 +173,14 @@ class OwlDetector(Detector):
                  sam_path: str | Path | None = None, device: str = "cpu", max_detections: int = 50,
                  prompt: str = "a photo of a {}", depth_band: float = 0.4, depth_extent: float = 1.5,
                  floor_height: float | None = 0.05, min_mask_area: float = 2e-4) -> None:
+        score_threshold, nms_iou = _number("score_threshold", score_threshold), _number("nms_iou", nms_iou)
+        depth_band, depth_extent = _number("depth_band", depth_band), _number("depth_extent", depth_extent)
+        min_mask_area = _number("min_mask_area", min_mask_area)
+        floor_height = None if floor_height is None else _number("floor_height", floor_height)
+        if isinstance(max_detections, bool) or not isinstance(max_detections, int):
+            raise InputError(f"max_detections must be an integer, got {max_detections!r}")
+        if not isinstance(prompt, str) or not isinstance(mask, str) or not isinstance(device, str):
+            raise InputError(f"prompt, mask and device must be text, got {prompt!r}, {mask!r}, {device!r}")
         if mask not in MASK_MODES:
             raise InputError(f"unknown mask mode {mask!r}; available: {', '.join(MASK_MODES)}")
         if not 0.0 <= float(score_threshold) <= 1.0:
@@ -176,8 +197,10 @@ class OwlDetector(Detector):
             raise InputError(f"min_mask_area is a fraction of the image in [0, 1), got {min_mask_area}")
         if mask == "sam" and sam_path is None:
             raise InputError("mask='sam' needs sam_path (a local SAM model folder)")
+        if mask != "sam" and sam_path is not None:
+            raise InputError(f"sam_path is only used with mask='sam' (mask is {mask!r})")
         folder = _require_folder(model_path, "owl model_path")
-        sam_folder = _require_folder(sam_path, "sam_path") if mask == "sam" and sam_path is not None else None
+        sam_folder = _require_folder(sam_path, "sam_path") if sam_path is not None else None
         torch, transformers = _import_backend()
         self._torch = torch
         self.model_path, self.sam_path = folder, sam_folder
