@@ -288,6 +288,29 @@ def test_owl_detector_properties(models: dict[str, Path], frames: list, kind: st
     assert total > 0, "a zero threshold should let the random model's boxes through"
 
 
+@pytest.mark.parametrize("kind", ["owlvit", "owlv2"])
+def test_boxes_are_in_frame_pixels(models: dict[str, Path], frames: list, kind: str) -> None:
+    """OWL-ViT stretches the frame to a square, OWLv2 pads it (bottom/right) first: the pixel boxes
+    must undo that, checked against the raw normalised (cx, cy, w, h) predictions."""
+    det = create_detector("owl", model_path=models[kind], score_threshold=0.0, nms_iou=1.0, max_detections=1000,
+                          mask="box", min_mask_area=0.0)
+    f = frames[0]
+    h, w = f.shape
+    inputs = det.processor(text=[det.prompts], images=f.rgb, truncation=True, return_tensors="pt")
+    with torch.inference_mode():
+        out = det.model(**inputs)
+    cx, cy, bw, bh = out.pred_boxes[0].double().numpy().T
+    sx, sy = (max(h, w), max(h, w)) if kind == "owlv2" else (w, h)
+    raw = np.stack([(cx - bw / 2) * sx, (cy - bh / 2) * sy, (cx + bw / 2) * sx, (cy + bh / 2) * sy], axis=1)
+    raw[:, [0, 2]] = raw[:, [0, 2]].clip(0, w)
+    raw[:, [1, 3]] = raw[:, [1, 3]].clip(0, h)
+    scored = torch.sigmoid(out.logits[0].max(dim=-1).values).numpy() > 0  # post-processing keeps score > threshold
+    raw = raw[((raw[:, 2] - raw[:, 0]) >= 1) & ((raw[:, 3] - raw[:, 1]) >= 1) & scored]
+    got = det.boxes(f)[0]
+    assert len(got) == len(raw) > 0
+    assert np.allclose(np.sort(got, axis=0), np.sort(raw, axis=0), atol=1e-3)
+
+
 def test_threshold_nms_and_cap_hold(models: dict[str, Path], frames: list) -> None:
     loose = create_detector("owl", model_path=models["owlv2"], score_threshold=0.0, nms_iou=1.0,
                             max_detections=1000, mask="box", min_mask_area=0.0)

@@ -3,15 +3,14 @@
 This is the backend for real recordings (no simulator truth). The text queries are CapNav's
 category names (``capnav.core.categories``) as prompts, so ``class_id`` and ``label`` mean the
 same as the simulator detector's; other vocabulary entries get ``class_id`` 0. Boxes come from
-the processor's ``post_process_grounded_object_detection`` (which undoes OWLv2's square padding)
-in the frame's pixels, are clipped to the image, suppressed per class (NMS) and cut to
-``max_detections``. The mapper needs a mask per detection: ``mask="depth"`` (default) keeps the
-object's depth surface inside the box (``capnav.perception.box_masks``; the floor, world
-z < ``floor_height``, is left out; ``floor_height=None`` when poses do not put the floor at
-z = 0), ``mask="sam"`` prompts a
-local SAM folder with all boxes of the frame at once, ``mask="box"`` fills the box. A mask is
-always cut to its box, and a detection whose mask is smaller than ``min_mask_area`` (fraction
-of the image) is dropped.
+the image processor's ``post_process_object_detection`` in the frame's pixels (OWLv2's boxes
+scaled by its padded square's side), are clipped to the image, suppressed per class (NMS) and
+cut to ``max_detections``. The mapper needs a mask per detection: ``mask="depth"`` (default)
+keeps the object's depth surface inside the box (``capnav.perception.box_masks``; the floor,
+world z < ``floor_height``, is left out; set ``floor_height=None`` when the poses do not put the
+floor at z = 0), ``mask="sam"`` prompts a local SAM folder with all boxes of the frame at once,
+``mask="box"`` fills the box. A mask is always cut to its box, and a detection whose mask is
+smaller than ``min_mask_area`` (fraction of the image) is dropped.
 
 Nothing is downloaded: folders are loaded with ``local_files_only=True`` and a path that is not
 an existing folder is refused. torch / transformers are imported when a detector is built, not
@@ -268,10 +267,15 @@ class OwlDetector(Detector):
                                           f"got {rgb.dtype} {rgb.shape}")
         # OWL's text encoder has 16 positions: a long prompt is cut rather than failing the frame.
         inputs = self.processor(text=[self.prompts], images=rgb, truncation=True, return_tensors="pt").to(self.device)
+        # OWLv2 pads the image to a square (bottom / right) before resizing, so its boxes are relative
+        # to that square: scaling by (side, side) is right both for transformers versions that scale
+        # OWLv2 boxes per axis and for those that already use max(h, w).
+        side = max(h, w)
+        target = (side, side) if self.model_type == "owlv2" else (h, w)
         with torch.inference_mode():
             outputs = self.model(**inputs)
-            res = self.processor.post_process_grounded_object_detection(
-                outputs, threshold=self.score_threshold, target_sizes=[(h, w)])[0]
+            res = self.processor.image_processor.post_process_object_detection(
+                outputs, threshold=self.score_threshold, target_sizes=[target])[0]
         boxes = res["boxes"].detach().cpu().double().numpy().reshape(-1, 4)
         scores = res["scores"].detach().cpu().double().numpy().ravel()
         labels = res["labels"].detach().cpu().numpy().astype(np.int64).ravel()
