@@ -376,7 +376,7 @@ def test_refusals(models: dict[str, Path], tmp_path: Path, monkeypatch: pytest.M
     with pytest.raises(InputError, match="needs model_path"):
         create_detector("owl")
     for bad in ({"score_threshold": 1.5}, {"score_threshold": "high"}, {"max_detections": 2.5},
-                {"depth_band": None}, {"prompt": 3}, {"sam_path": str(models["sam"])}):
+                {"depth_band": None}, {"prompt": 3}, {"prompt": "a {} in {room}"}, {"sam_path": str(models["sam"])}):
         with pytest.raises(InputError, match=next(iter(bad))):
             create_detector("owl", model_path=str(models["owlvit"]), **bad)
     monkeypatch.setitem(sys.modules, "transformers", None)  # the runtime install: no extras

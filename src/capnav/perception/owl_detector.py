@@ -205,7 +205,10 @@ class OwlDetector(Detector):
         self.model_path, self.sam_path = folder, sam_folder
         self.words = parse_vocabulary(vocabulary)
         self.classes = vocabulary_labels(self.words)
-        self.prompts = [prompt.format(w) for w in self.words]
+        try:
+            self.prompts = [prompt.format(w) for w in self.words]
+        except (IndexError, KeyError, ValueError) as e:
+            raise InputError(f"prompt {prompt!r} must hold exactly one '{{}}' and no other braces ({e!r})") from None
         self.score_threshold, self.nms_iou = float(score_threshold), float(nms_iou)
         self.mask_mode, self.max_detections = mask, int(max_detections)
         self.depth_band, self.depth_extent = float(depth_band), float(depth_extent)
