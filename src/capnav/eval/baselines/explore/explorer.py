@@ -356,7 +356,8 @@ class FrontierExplorer:
         t = target()
         if t is not None and math.dist(self.xy, t) <= stop_distance:
             return Status.ARRIVED
-        return Status.STOPPED if st is Status.STOPPED else st
+        # At the best standing cell the map knows, yet not near the target: no closer cell is reachable.
+        return Status.BLOCKED if st is Status.ARRIVED else st
 
 
 def _wrap(a: float) -> float:
