@@ -19,6 +19,10 @@ def test_category_in_text() -> None:
     assert category_in_text("the smallest coffee table") == "coffee table"  # not "table"
     assert category_in_text("the tallest bookcases") == "bookshelf"
     assert category_in_text("the piano") is None
+    # the same reading as CapNav's parser: typos, and the target rather than the landmark
+    assert category_in_text("Take me to the smalest lounge chiar.") == "armchair"
+    assert category_in_text("the lamp next to the sofa") == "lamp"
+    assert category_in_text("   ") is None
 
 
 def test_topdown_features_pool_and_normalise() -> None:

@@ -19,6 +19,7 @@ from capnav.retrieval import parse_instruction, validate_instruction
     ("the closest bedside table", {"category": "nightstand", "proximity": "closest"}),
     ("the longe chair", {"category": "armchair"}), ("the cofee table", {"category": "coffee table"}),
     ("Navigate to the bedsde table.", {"category": "nightstand"}), ("the wood table", {"category": "table"}),
+    ("take me to the chai", {"category": "chair"}),  # one letter short is still a typo
     ("the plant in the yellow terracotta pot", {"category": "plant", "colors": ["yellow"]}),
     ("the gray armchair beside the lamp in the study",
      {"category": "armchair", "colors": ["grey"], "relation": "next to", "anchor_category": "lamp",
@@ -28,6 +29,10 @@ def test_parse(text, expect):
     q = parse_instruction(text).to_dict()
     for k, v in expect.items():
         assert q[k] == v, (k, q)
+
+
+def test_a_truncated_word_is_not_a_typo() -> None:
+    assert parse_instruction("somewhere to wash my hands").category is None  # "wash" is no "washer"
 
 
 @pytest.mark.parametrize(("text", "cat", "unknown"), [

@@ -138,7 +138,8 @@ def _find_category(words: list[str]) -> tuple[str | None, tuple[int, int] | None
         if len(w) < 4 or w in _FILLER or canonical_color(w) or w in _SHAPES or w in _SIZE_WORDS:
             continue
         near = difflib.get_close_matches(w, _SINGLE_FORMS, n=1, cutoff=0.8)
-        if near:
+        # A word two or more letters short of a name's start is another word, not a typo ("wash").
+        if near and not (near[0].startswith(w) and len(near[0]) - len(w) >= 2):
             return _FORM_MAP[near[0]], (i, i + 1), True
     return None, None, False
 

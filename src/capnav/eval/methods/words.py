@@ -1,27 +1,24 @@
-"""Find the vocabulary category a goal text names (for methods that only understand categories)."""
+"""Find the vocabulary category a goal text names (for methods that only understand categories).
+
+The baselines read the goal with CapNav's own instruction parser (``capnav.retrieval.query``), so
+every method gets the same reading of the same words: synonyms, plurals, small typos ("lounge
+chiar"), and the target rather than a landmark ("the lamp next to the sofa" is a lamp). What they
+lack is what comes after: captions, attributes and predicates.
+"""
 
 from __future__ import annotations
 
-import re
-from functools import lru_cache
-
-from capnav.core.categories import CATEGORIES
-
-
-@lru_cache(maxsize=1)
-def _pattern() -> tuple[re.Pattern[str], dict[str, str]]:
-    phrases = {c.name: c.name for c in CATEGORIES}
-    phrases.update({s: c.name for c in CATEGORIES for s in c.synonyms})
-    # longest first, so "coffee table" is read before "table" and "bar stool" before "stool"
-    alts = sorted(phrases, key=len, reverse=True)
-    return re.compile(r"\b(" + "|".join(re.escape(a) for a in alts) + r")s?\b"), phrases
+from capnav.core.errors import InputError
+from capnav.retrieval.query import parse_instruction
 
 
 def category_in_text(text: str) -> str | None:
-    """The category of the first vocabulary phrase (name or synonym, singular or plural) in ``text``.
+    """The target category of ``text`` (canonical vocabulary name), or None when it names none
+    or is not a usable instruction (empty, not English).
 
-    "the red chair next to the sofa" -> "chair"; "go to the couch" -> "sofa"; none -> None.
+    "the red chair next to the sofa" -> "chair"; "go to the couch" -> "sofa"; "the piano" -> None.
     """
-    pat, phrases = _pattern()
-    m = pat.search(text.lower().replace("_", " "))
-    return phrases[m.group(1)] if m else None
+    try:
+        return parse_instruction(text).category
+    except InputError:
+        return None
