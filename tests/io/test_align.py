@@ -2,33 +2,18 @@
 
 from __future__ import annotations
 
-import math
-from collections.abc import Iterator
-
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
 from capnav.core.errors import InputError
 from capnav.core.frame import Frame
-from capnav.core.geometry import look_at_pose
 from capnav.io.align import FloorConfig, fit_floor, floor_alignment, parse_up, rotation_between
-from capnav.sim import CameraConfig, LayoutConfig, SimConfig, Simulator
-
-CFG = SimConfig(layout=LayoutConfig(rooms=3), camera=CameraConfig(width=160, height=120))
 
 
 @pytest.fixture(scope="module")
-def frames() -> Iterator[list[Frame]]:
-    sim = Simulator.from_seed(0, CFG)
-    rng = np.random.default_rng(1)
-    out = []
-    for i in range(8):
-        x, y = sim.random_navigable_point(rng)
-        out.append(sim.render(look_at_pose(np.array([x, y, 1.25]), float(rng.uniform(-math.pi, math.pi)),
-                                           math.radians(25.0)), index=i))
-    yield out
-    sim.close()
+def frames(render_views) -> list[Frame]:  # type: ignore[no-untyped-def]
+    return render_views(1, [25.0] * 8)
 
 
 def _world(up: str, tilt_deg: float, yaw_deg: float, lift: float) -> np.ndarray:

@@ -5,9 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import io
-import math
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -20,18 +18,15 @@ from typer.testing import CliRunner
 from capnav.cli import app
 from capnav.core.errors import InputError, PoseError
 from capnav.core.frame import Frame
-from capnav.core.geometry import look_at_pose
 from capnav.io.dataset import DatasetReader
 from capnav.io.importer import import_recording
 from capnav.io.rosbag import RosbagReader, parse_extrinsic
-from capnav.sim import CameraConfig, LayoutConfig, SimConfig, Simulator
 
 pytest.importorskip("rosbags")
 from rosbags.rosbag1 import Writer as Writer1
 from rosbags.rosbag2 import Writer as Writer2
 from rosbags.typesys import Stores, get_typestore
 
-CFG = SimConfig(layout=LayoutConfig(rooms=3), camera=CameraConfig(width=160, height=120))
 T0 = 1_700_000_000.0
 # camera optical frame in a robot body frame (x forward, z up): optical z = body x, x = -y, y = -z
 T_BC = np.eye(4)
@@ -52,16 +47,8 @@ def _world(up_y: bool) -> np.ndarray:
 
 
 @pytest.fixture(scope="module")
-def frames() -> Iterator[list[Frame]]:
-    sim = Simulator.from_seed(0, CFG)
-    rng = np.random.default_rng(5)
-    out = []
-    for i in range(5):
-        x, y = sim.random_navigable_point(rng)
-        out.append(sim.render(look_at_pose(np.array([x, y, 1.25]), float(rng.uniform(-math.pi, math.pi)),
-                                           math.radians(22.0)), index=i))
-    yield out
-    sim.close()
+def frames(render_views) -> list[Frame]:  # type: ignore[no-untyped-def]
+    return render_views(5, [22.0] * 5)
 
 
 def _make(ts: Any, name: str, **kw: Any) -> Any:

@@ -4,8 +4,6 @@ come back as the original z-up poses; association, interpolation, skip reports a
 from __future__ import annotations
 
 import json
-import math
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -17,14 +15,11 @@ from typer.testing import CliRunner
 from capnav.cli import app
 from capnav.core.errors import InputError, PoseError
 from capnav.core.frame import Frame
-from capnav.core.geometry import look_at_pose
 from capnav.io.assoc import PoseTrack, match_nearest
 from capnav.io.dataset import DatasetReader
 from capnav.io.importer import import_recording
 from capnav.io.tum import TumReader
-from capnav.sim import CameraConfig, LayoutConfig, SimConfig, Simulator
 
-CFG = SimConfig(layout=LayoutConfig(rooms=3), camera=CameraConfig(width=160, height=120))
 # the recording's world: CapNav's +z is its -y (x axis turned +90 degrees), floor at y = +1.3 m
 W = np.eye(4)
 W[:3, :3] = Rotation.from_euler("x", 90, degrees=True).as_matrix()
@@ -33,16 +28,8 @@ T0 = 1305031102.0  # TUM-like stamps: large numbers, so float parsing precision 
 
 
 @pytest.fixture(scope="module")
-def frames() -> Iterator[list[Frame]]:
-    sim = Simulator.from_seed(0, CFG)
-    rng = np.random.default_rng(3)
-    out = []
-    for i in range(6):
-        x, y = sim.random_navigable_point(rng)
-        yaw = float(rng.uniform(-math.pi, math.pi))
-        out.append(sim.render(look_at_pose(np.array([x, y, 1.25]), yaw, math.radians(20.0 + 3 * i)), index=i))
-    yield out
-    sim.close()
+def frames(render_views) -> list[Frame]:  # type: ignore[no-untyped-def]
+    return render_views(3, [20.0 + 3 * i for i in range(6)])
 
 
 def _line(t: float, T: np.ndarray) -> str:
