@@ -153,7 +153,7 @@ class FrontierExplorer:
                 or abs(_wrap(yaw - yaw0)) >= math.radians(cfg.keyframe_turn_deg) - 1e-6)
 
     def look_around(self, stop: StopCheck | None = None) -> Status:
-        """A full turn in place, observing at every heading."""
+        """A full turn in place, looking at every keyframe heading (every 60 degrees by default)."""
         for _ in range(max(1, round(2 * math.pi / self.turn)) - 1):
             if self.budget <= 0:
                 return Status.BUDGET
@@ -163,7 +163,7 @@ class FrontierExplorer:
         return Status.ARRIVED
 
     def face(self, xy: tuple[float, float], stop: StopCheck | None = None) -> Status:
-        """Turn in place towards ``xy`` (a frontier's unknown side), observing at every heading."""
+        """Turn in place towards ``xy`` (a frontier's unknown side), looking at keyframe headings."""
         x, y, yaw = (float(v) for v in self.agent.pose)
         if math.dist((x, y), xy) < 1e-6:
             return Status.ARRIVED
