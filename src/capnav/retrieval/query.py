@@ -80,6 +80,13 @@ class ParsedQuery:
     anchor_phrase: str | None = None
     room: str | None = None
     unknown_words: list[str] = field(default_factory=list)
+    #: Other categories the target words may denote, with a weight below 1 (a chair request may
+    #: be served by an armchair or a stool, ranked below chairs; a purpose maps to several).
+    category_alternatives: dict[str, float] = field(default_factory=dict)
+    purpose: str | None = None  # the request named a use ("somewhere to sit"), not an object
+    negations: list[str] = field(default_factory=list)  # phrases the target must NOT match ("white")
+    ordinal: int | None = None  # 2 for "the second closest"
+    proximity_to_anchor: bool = False  # "the chair closest to the table": distance to the anchor
 
     @property
     def has_attributes(self) -> bool:
