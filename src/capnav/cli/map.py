@@ -33,14 +33,16 @@ def register(app: typer.Typer) -> None:
     def map_cmd(
         dataset: Path = typer.Argument(..., help="dataset folder (capnav-rgbd format)"),
         output: Path = typer.Option(..., "-o", "--output", help="map file to write (e.g. apt0.capnav)"),
-        detector: str = typer.Option("sim", help="detector backend: sim (simulator recordings only) or owl "
-                                                 "(OWL-ViT / OWLv2 from a local folder, docs/perception.md)"),
+        detector: str = typer.Option("sim", help="detector backend: sim (simulator recordings only), yolo-fastest "
+                                                 "or centernet (COCO-80 on real pixels, CPU; capnav models install), "
+                                                 "owl (OWL-ViT / OWLv2 from a local folder); docs/perception.md"),
         noise: str = typer.Option("default", help="sim detector noise: default, hard, oracle"),
         seed: int = typer.Option(0, help="seed of the sim detector's noise"),
         detector_option: list[str] = typer.Option(
             [], "--detector-option", metavar="KEY=VALUE",
             help="detector setting passed to the backend, repeatable; VALUE is JSON when it parses, else "
-                 "text (owl: model_path=DIR, mask=depth|sam|box, sam_path=DIR, score_threshold=0.1, ...)"),
+                 "text (yolo-fastest/centernet: model_dir=DIR, score_threshold=0.3, classes=indoor|all; owl: "
+                 "model_path=DIR, mask=depth|sam|box, ...)"),
         encoder: str = typer.Option("label-embedding", help="dense feature encoder backend"),
         embedder: str = typer.Option("minilm", help="text embedder of the label-embedding encoder"),
         max_frames: int | None = typer.Option(None, help="use only the first N frames"),

