@@ -34,3 +34,21 @@ def render_views() -> Callable[[int, Sequence[float]], list[Frame]]:
             sim.close()
 
     return render
+
+
+@pytest.fixture(scope="session")
+def wall_views() -> Callable[[float], list[Frame]]:
+    """``walls(dx)``: five views of apartment 0 (160x120) looking level (pitch 0) at the same wall,
+    the camera 1.25 m up and sliding sideways 0.8 m along it; ``dx = 0`` stands 2.3 m from the wall
+    (the floor is a strip at the bottom, a few percent of the pixels), ``dx = 1.2`` stands 1.1 m
+    from it (no floor in view)."""
+
+    def render(dx: float) -> list[Frame]:
+        sim = Simulator.from_seed(0, SIM_CFG)
+        try:
+            return [sim.render(look_at_pose(np.array([2.675 + dx, 5.325 + s, 1.25]), 0.0, 0.0), index=i)
+                    for i, s in enumerate(np.linspace(-0.4, 0.4, 5))]
+        finally:
+            sim.close()
+
+    return render

@@ -82,7 +82,7 @@ def test_round_trip_aligned(tmp_path: Path, frames: list[Frame]) -> None:
     assert rec.skipped.counts() == {"no depth within max-dt 0.02 s": 1}
     assert rec.skipped.skips[0].name == f"rgb/{T0 + 0.4:.6f}.png" and "50 ms" in rec.skipped.skips[0].detail
     report = import_recording(rec, tmp_path / "ds", up="-y", progress=False)
-    assert report.written == 5 and report.alignment.info["method"] == "floor-ransac"
+    assert report.written == 5 and report.alignment.info["method"] == "floor-named"
     ds = DatasetReader(tmp_path / "ds")
     assert len(ds) == 5 and ds.intrinsics == frames[0].K and ds.has_gt is False
     assert ds.meta["meta"]["import"]["skipped"] == {"no depth within max-dt 0.02 s": 1}
@@ -174,14 +174,18 @@ def test_cli(tmp_path: Path, frames: list[Frame]) -> None:
     seq = tmp_path / "rgbd_dataset_freiburg1_sim"
     write_tum(seq, frames[:4], depth_lag={1: -0.03})
     args = ["import", "tum", str(seq), "-o", str(tmp_path / "ds"), "--intrinsics", str(seq / "cam.json"),
-            "--up", "-y", "--no-progress"]
-    res = CliRunner().invoke(app, args)
+            "--no-progress"]
+    res = CliRunner().invoke(app, args)  # no --up: found from the floor and the cameras
     assert res.exit_code == 0, res.output
     assert "3 frames written" in res.output and "skipped 1: no depth within max-dt" in res.output
+    assert "up found: the recording's" in res.output and "deg from -y; confidence" in res.output
     assert len(DatasetReader(tmp_path / "ds")) == 3
     res = CliRunner().invoke(app, args)  # existing dataset: refuse without --overwrite
     assert res.exit_code != 0 and "not empty" in str(res.exception)
     res = CliRunner().invoke(app, [*args, "--overwrite", "--max-frames", "2"])
     assert res.exit_code == 0, res.output
     assert len(DatasetReader(tmp_path / "ds")) == 2
+    res = CliRunner().invoke(app, [*args, "--overwrite", "--up", "+z"])  # the floor is the recording's -y
+    assert res.exit_code != 0 and "--up +z contradicts the recording" in str(res.exception)
+    assert len(DatasetReader(tmp_path / "ds")) == 2  # the dataset already there is kept
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]

@@ -21,8 +21,9 @@ MaxDt = Annotated[float, typer.Option("--max-dt", help="max colour-depth time di
 MaxPoseGap = Annotated[float, typer.Option("--max-pose-gap", help="max gap between the pose stamps around a frame (s)")]
 Stride = Annotated[int, typer.Option("--stride", help="keep every k-th associated frame")]
 MaxFrames = Annotated[int | None, typer.Option("--max-frames", help="keep only the first N selected frames")]
-Up = Annotated[str, typer.Option("--up", help="the recording's approximate up axis (+z, -y, +y, ...) refined by a "
-                                              "floor fit, or 'none' to keep its frame")]
+Up = Annotated[str, typer.Option("--up", help="'auto' finds up from the floor and the cameras (refuses when unsure); "
+                                              "an axis (+z, -y, ...) is refined by the floor and checked; 'none' "
+                                              "keeps the recorded frame")]
 Overwrite = Annotated[bool, typer.Option("--overwrite", help="replace an existing dataset folder")]
 Progress = Annotated[bool, typer.Option(help="show progress")]
 
@@ -56,7 +57,7 @@ def register(app: typer.Typer) -> None:
                                                    "(default: from a folder name like ..._freiburg2_...)"),
         depth_scale: float = typer.Option(5000.0, "--depth-scale", help="depth PNG units per metre"),
         max_dt: MaxDt = 0.02, max_pose_gap: MaxPoseGap = 0.5, stride: Stride = 1, max_frames: MaxFrames = None,
-        up: Up = "+z", overwrite: Overwrite = False, progress: Progress = True,
+        up: Up = "auto", overwrite: Overwrite = False, progress: Progress = True,
     ) -> None:
         """Import a TUM RGB-D benchmark sequence (ground truth: camera optical frame to the mocap world)."""
         from capnav.io.tum import TumReader
@@ -77,7 +78,7 @@ def register(app: typer.Typer) -> None:
                                                   help="x,y,z,qx,qy,qz,qw of the camera optical frame in the "
                                                        "pose topic's body frame"),
         max_dt: MaxDt = 0.02, max_pose_gap: MaxPoseGap = 0.5, stride: Stride = 1, max_frames: MaxFrames = None,
-        up: Up = "+z", overwrite: Overwrite = False, progress: Progress = True,
+        up: Up = "auto", overwrite: Overwrite = False, progress: Progress = True,
     ) -> None:
         """Import a ROS1/ROS2 bag (read with the rosbags library; no ROS install needed)."""
         from capnav.io.rosbag import RosbagReader

@@ -22,8 +22,9 @@ from capnav.core.errors import DatasetError, InputError
 from capnav.core.frame import Frame
 from capnav.core.geometry import Intrinsics
 from capnav.core.progress import track
-from capnav.io.align import Alignment, FloorConfig, floor_alignment
+from capnav.io.align import Alignment, floor_alignment
 from capnav.io.assoc import SkipLog
+from capnav.io.up_axis import CUES, UpConfig
 
 
 @dataclass(frozen=True)
@@ -70,10 +71,16 @@ class ImportReport:
         a = self.alignment.info
         out = [f"{self.out}: {self.written} frames written from a {self.kind} recording "
                f"({self.associated} associated, {self.selected} selected) in {self.seconds:.1f} s"]
-        if a.get("method") == "floor-ransac":
-            out.append(f"floor aligned (--up {self.alignment.up}): {a['floor_points']} floor points, "
-                       f"rms {100 * a['floor_rms_m']:.1f} cm, {a['tilt_from_up_deg']:.1f} deg from the named up axis, "
-                       f"floor was at {-self.alignment.A[2, 3]:+.3f} m along the fitted normal")
+        if a.get("method") in ("floor-auto", "floor-named"):
+            how = ("up found" if a["method"] == "floor-auto" else
+                   f"floor aligned (--up {self.alignment.up}, {a['tilt_from_up_deg']:.1f} deg from it)")
+            up = ", ".join(f"{v:+.3f}" for v in a["up_in_recording"])
+            f = a["facts"]
+            out.append(f"{how}: the recording's ({up}), {a['axis_angle_deg']:.1f} deg from {a['nearest_axis']}; "
+                       f"confidence {a['confidence']:.2f} (" + ", ".join(f"{c} {a['cues'][c]:.2f}" for c in CUES)
+                       + f"); floor {a['floor_points']} points ({100 * f['floor_share']:.0f}%), rms "
+                       f"{100 * a['floor_rms_m']:.1f} cm, cameras {f['camera_height_median_m']:.2f} m above it, "
+                       f"image-down {f['upright_deg']:.0f} deg from gravity")
         else:
             out.append("world frame kept as recorded (--up none)")
         for reason, n in self.skipped.counts().items():
@@ -101,9 +108,9 @@ def _check_target(out: Path, overwrite: bool) -> None:
             raise DatasetError(f"{out} is not a capnav-rgbd dataset folder; refusing to replace it")
 
 
-def import_recording(rec: Recording, out: str | Path, up: str = "+z", stride: int = 1,
+def import_recording(rec: Recording, out: str | Path, up: str = "auto", stride: int = 1,
                      max_frames: int | None = None, overwrite: bool = False, progress: bool = True,
-                     align_frames: int = 30, floor: FloorConfig | None = None) -> ImportReport:
+                     align_frames: int = 30, floor: UpConfig | None = None) -> ImportReport:
     """Write ``rec`` as a ``capnav-rgbd`` folder at ``out`` with every pose aligned (``T_wc' = A @ T_wc``)."""
     from capnav.io.dataset import DatasetWriter
 
@@ -117,7 +124,7 @@ def import_recording(rec: Recording, out: str | Path, up: str = "+z", stride: in
     pick = np.unique(np.round(np.linspace(0, len(frames) - 1, min(align_frames, len(frames)))).astype(int))
     shape = (rec.K.height, rec.K.width)
     views = ((d, f.T_wc) for f, d in rec.load_depths([frames[i] for i in pick]) if d.shape == shape)
-    align = floor_alignment(views, rec.K, up, floor)
+    align = floor_alignment(views, rec.K, up, floor, poses=np.stack([f.T_wc for f in frames]))
 
     skipped = SkipLog(list(rec.skipped.skips))
     tmp = out.parent / f".{out.name}.importing-{os.getpid()}"
