@@ -324,7 +324,9 @@ class CapNav:
             oid = target.id if isinstance(target, ObjectRecord) else int(target)
         obj = self.map.object(oid)
         try:
-            goal = select_goal(self.map.occupancy, obj.footprint, xy, self.planner_config, self.costmap)
+            goal = target.goal if isinstance(target, Answer) and target.robot == xy else None
+            if goal is None:  # an answer asked from this start already holds its goal: one search less
+                goal = select_goal(self.map.occupancy, obj.footprint, xy, self.planner_config, self.costmap)
             path = plan_path(self.map.occupancy, xy, goal.xy, self.planner_config, self.costmap)
         except NotFoundError as e:
             return Plan(False, np.array([[*xy, yaw0]]), 0.0, str(e), None, oid)
