@@ -121,3 +121,37 @@ def test_pose_jumps_are_reported(frames: list, embedder) -> None:  # type: ignor
     far[:3, 3] += [2.0, 0.0, 0.0]
     m.integrate(dataclasses.replace(frames[1], T_wc=far))
     assert m.finish().meta["pose_jumps"] == [{"frame": 1, "metres": pytest.approx(2.0, abs=0.2)}]
+
+
+class _Flaky(Detector):
+    """Fails on every fourth frame and on frames 5 and 9, in two different ways."""
+
+    id = "flaky"
+
+    def __init__(self, inner: Detector) -> None:
+        self.inner = inner
+
+    def detect(self, frame):  # type: ignore[no-untyped-def]
+        if frame.index % 4 == 3:
+            raise RuntimeError(f"model crashed on input {frame.index}")
+        if frame.index in (5, 9):
+            raise FrameError(frame.index, "bad image")
+        return self.inner.detect(frame)
+
+
+def test_detector_failures_keep_the_geometry(embedder) -> None:  # type: ignore[no-untyped-def]
+    frames = orbit(24)
+    blind = _mapper(embedder, detector=_Fixed([]))
+    flaky = _mapper(embedder, detector=_Flaky(create_detector("sim", noise="oracle")))
+    for f in frames:
+        assert blind.integrate(f) and flaky.integrate(f)
+    a, b = blind.finish(), flaky.finish()
+    assert b.meta["frames_used"] == len(frames) and not b.meta["frames_skipped"]
+    assert len(b.voxels) == len(a.voxels)  # every frame's depth is fused, detections or not
+    assert np.array_equal(b.voxels.keys, a.voxels.keys)
+    assert np.array_equal(b.occupancy.cells, a.occupancy.cells)
+    errs = {e["kind"]: (e["count"], e["first_frame"]) for e in b.meta["detector_errors"]}
+    assert errs == {"RuntimeError: model crashed on input #": (6, 3), "FrameError: bad image": (2, 5)}
+    assert b.objects and not a.objects  # the frames it did detect on still give objects
+    with pytest.raises(RuntimeError, match="model crashed"):
+        _mapper(embedder, strict=True, detector=_Flaky(_Fixed([]))).integrate(frames[3])

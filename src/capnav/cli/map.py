@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -72,8 +73,32 @@ def register(app: typer.Typer) -> None:
         save_map(cmap, output)
         con = Console(stderr=True)
         m = cmap.meta
-        fps = m["frames_used"] / m["mapping_seconds"] if m["mapping_seconds"] else float("nan")
+        speed = f" ({m['frames_used'] / m['mapping_seconds']:.1f} frames/s)" if m["mapping_seconds"] else ""
         con.print(f"{output}: {len(cmap.objects)} objects, {len(cmap.voxels)} voxels, "
-                  f"{m['frames_used']} frames ({fps:.1f} frames/s), detector {det.id}")
-        for s in m["frames_skipped"]:
-            con.print(f"[yellow]skipped frame {s['frame']}:[/] {s['reason']}", highlight=False)
+                  f"{m['frames_used']} frames{speed}, detector {det.id}")
+        for reason, frames in _grouped(m["frames_skipped"]):
+            con.print(f"[yellow]skipped {_frames(frames)}:[/] {reason}", highlight=False)
+        for err in m.get("detector_errors", []):
+            con.print(f"[yellow]detector failed on {err['count']} frame(s) (first: {err['first_frame']}), their depth "
+                      f"still mapped:[/] {err['example']}", highlight=False)
+        if not cmap.objects:
+            failed = sum(e["count"] for e in m.get("detector_errors", []))
+            h_min = m["config"]["tracker"]["h_min"]
+            why = (f"the detector failed on {failed} of {m['frames_used']} frames" if failed else
+                   "no frame could be used" if not m["frames_used"] else
+                   f"none of {m['tracks']} tracks was seen in {h_min} frames (h_min)" if m["tracks"] else
+                   "the detector found nothing it keeps in these frames (try a lower score_threshold, "
+                   "or another --detector)")
+            con.print(f"[yellow]warning:[/] the map has 0 objects: {why}", highlight=False)
+
+
+def _grouped(skips: list[dict[str, Any]]) -> list[tuple[str, list[Any]]]:
+    """Skipped frames grouped by reason (numbers blanked), in first-seen order, with one example reason."""
+    groups: dict[str, tuple[str, list[Any]]] = {}
+    for s in skips:
+        groups.setdefault(re.sub(r"[0-9]+", "#", str(s["reason"])), (str(s["reason"]), []))[1].append(s["frame"])
+    return list(groups.values())
+
+
+def _frames(frames: list[Any]) -> str:
+    return f"frame {frames[0]}" if len(frames) == 1 else f"{len(frames)} frames (first: {frames[0]})"

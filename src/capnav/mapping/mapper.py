@@ -4,6 +4,7 @@ lifted detections -> SG3DTracker (Algorithm 1) -> persistent objects -> ``CapNav
 from __future__ import annotations
 
 import logging
+import re
 import time
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
@@ -33,6 +34,9 @@ class MapperConfig:
 
     ``on_bad_frame``: "skip" records the frame and the reason in ``meta["frames_skipped"]`` and
     goes on (one bad frame in 10,000 should not lose a map); "raise" stops with ``FrameError``.
+    A detector that raises on a frame does not lose it: under "skip" the frame's depth is fused
+    without detections, the tracker does not see the frame (no detections is not evidence of
+    absence), and the failure is counted per kind in ``meta["detector_errors"]``.
     Frames with more than ``max_invalid_depth`` invalid depth pixels count as bad. A camera that
     moves more than ``max_pose_jump`` between consecutive used frames is listed in
     ``meta["pose_jumps"]`` (a wrong pose convention or a dropped stretch of frames shows up there).
@@ -75,6 +79,7 @@ class Mapper:
         self.memory = ObjectMemory(self.config.memory)
         self.frames_used: list[int] = []
         self.skipped: list[dict[str, Any]] = []
+        self.detector_errors: dict[str, dict[str, Any]] = {}
         self.lift_skips = 0
         self.pose_jumps: list[dict[str, Any]] = []
         self._last_eye: NDArray[np.float64] | None = None
@@ -86,6 +91,18 @@ class Mapper:
         self.record_skip(err.frame, err.reason)
         return False
 
+    def _detector_failed(self, frame: int, err: Exception) -> None:
+        """Count a detector failure by kind (type + reason, numbers blanked); log each kind once."""
+        reason = err.reason if isinstance(err, FrameError) else str(err)
+        kind = f"{type(err).__name__}: {re.sub(r'[0-9]+', '#', reason)}"
+        entry = self.detector_errors.get(kind)
+        if entry is None:
+            log.warning("frame %s: the detector failed (%s: %s); mapping its depth without detections",
+                        frame, type(err).__name__, reason)
+            self.detector_errors[kind] = {"kind": kind, "count": 1, "first_frame": frame, "example": reason}
+        else:
+            entry["count"] += 1
+
     def record_skip(self, frame: int | str, reason: str) -> None:
         """Note a frame that could not be used (also for frames a reader failed to load)."""
         log.warning("skipping frame %s: %s", frame, reason)
@@ -96,8 +113,17 @@ class Mapper:
         t0 = time.perf_counter()
         try:
             frame.validate(max_invalid_fraction=self.config.max_invalid_depth)
+        except FrameError as e:
+            return self._bad(e)
+        try:
             dets = validate_detections(frame, self.detector.detect(frame))
-            grid, table = self.encoder.encode_indexed(frame, dets)
+        except Exception as e:  # any detector failure: the frame's geometry still counts
+            if self.config.on_bad_frame == "raise":
+                raise
+            self._detector_failed(frame.index, e)
+            dets = None
+        try:
+            grid, table = self.encoder.encode_indexed(frame, dets or [])
             grid = np.asarray(grid, dtype=np.int64)
             table = np.asarray(table, dtype=np.float32)
             if table.ndim != 2 or table.shape[1] != self.encoder.dim or grid.ndim != 2:
@@ -120,14 +146,15 @@ class Mapper:
         proj = self.voxels.project(table) if self.voxels.projection is not None else table
         self.voxels.integrate_frame(frame.depth, frame.rgb, frame.K, frame.T_wc, grid, proj, vc.sigma,
                                     vc.max_depth, vc.pixel_stride)
-        lifted: list[LiftedDetection] = []
-        for k, d in enumerate(dets):
-            ld = lift_detection(frame, d, k, grid, table, self.config.lift)
-            if ld is None:
-                self.lift_skips += 1
-                continue
-            lifted.append(ld)
-        self._track(frame, lifted)
+        if dets is not None:  # a frame the detector failed on is no evidence that objects are gone
+            lifted: list[LiftedDetection] = []
+            for k, d in enumerate(dets):
+                ld = lift_detection(frame, d, k, grid, table, self.config.lift)
+                if ld is None:
+                    self.lift_skips += 1
+                    continue
+                lifted.append(ld)
+            self._track(frame, lifted)
         self.frames_used.append(frame.index)
         self.seconds += time.perf_counter() - t0
         return True
@@ -158,6 +185,7 @@ class Mapper:
             "first_frame": self.frames_used[0] if self.frames_used else None,
             "last_frame": self.frames_used[-1] if self.frames_used else None,
             "frames_skipped": list(self.skipped),
+            "detector_errors": list(self.detector_errors.values()),
             "pose_jumps": list(self.pose_jumps),
             "detections_without_depth": self.lift_skips,
             "tracks": self.tracker._next_id - 1,

@@ -76,6 +76,9 @@ class Detector(ABC):
     (stored in the map's metadata so a map says how it was made)."""
 
     id: str = "detector"
+    #: True for detectors that read the simulator's truth images (``Frame.gt_instance``), which a
+    #: real recording does not have: mapping such a dataset with one is refused before any frame.
+    needs_truth: bool = False
 
     @abstractmethod
     def detect(self, frame: Frame) -> list[Detection]:

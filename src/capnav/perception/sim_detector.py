@@ -97,6 +97,8 @@ def occluded_outline(inst: NDArray[np.integer], depth: NDArray[np.floating], gap
 class SimDetector(Detector):
     """Detections from the simulator's per-pixel truth, degraded by ``SimNoise``."""
 
+    needs_truth = True
+
     def __init__(self, noise: str | SimNoise = "default", seed: int = 0, **overrides: float) -> None:
         name, cfg = resolve_noise(noise)
         if overrides:
