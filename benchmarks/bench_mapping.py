@@ -6,7 +6,9 @@
    rendered first), per stage, on one core (numba / BLAS / onnxruntime limited to one thread).
 2. Voxel fusion in points/s on the same back-projected points: CapNav's eq. 5-8 fusion (64-dim
    features + colour + weight, incremental) side by side with Open3D's ``voxel_down_sample``
-   (colour + position only, one batch call). Skipped with a message if open3d is not installed.
+   (colour + position only, one batch call), min CPU time of 3 runs each, with the ratio beside
+   issue 16's targets. Open3D's voxels differ in number: it puts the grid origin at the cloud's
+   minimum corner, ours at eq. 4's fixed origin. Skipped with a message if open3d is not installed.
 3. Peak memory while mapping a whole apartment (tracemalloc peak of Python/numpy allocations, and
    the process's max RSS), and the size of the map.
 4. Mapping quality on each seed's apartment at the given detector noise vs issue #3's targets.
@@ -24,9 +26,11 @@ import resource  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
 import tracemalloc  # noqa: E402
+from collections.abc import Callable  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
+from numpy.typing import NDArray  # noqa: E402
 
 
 def _table(title: str, header: list[str], rows: list[list[str]]) -> None:
@@ -151,7 +155,20 @@ def detector_stats(frames: list) -> list[list[str]]:
     return rows
 
 
-def fusion_vs_open3d(frames: list) -> list[list[str]]:
+def _best_cpu(fn: Callable[[], object], repeat: int) -> tuple[float, object]:
+    """Smallest process CPU time of ``repeat`` calls (all threads; the min is the least disturbed
+    by the other jobs of a shared machine) and the last result."""
+    best, out = np.inf, None
+    for _ in range(repeat):
+        t0 = time.process_time()
+        out = fn()
+        best = min(best, time.process_time() - t0)
+    return best, out
+
+
+def fusion_vs_open3d(frames: list, repeat: int = 3) -> list[list[str]]:
+    """Both on the same back-projected points of every frame, 5 cm voxels, one thread, min CPU
+    time of ``repeat`` runs. Targets (issue 16): colour at >= 1x Open3D's rate, 64-d >= 0.5x."""
     from capnav.core.geometry import backproject
     from capnav.mapping import VoxelConfig, VoxelMap
 
@@ -166,32 +183,39 @@ def fusion_vs_open3d(frames: list) -> list[list[str]]:
     alpha = np.ones(n, np.float32)
     phi = np.random.default_rng(0).standard_normal((64, 64)).astype(np.float32)
     fidx = np.random.default_rng(1).integers(0, 64, n)
-    rows = []
     origin = VoxelConfig().grid_origin
+    ours: dict[int, tuple[float, int]] = {}
     for dim in (64, 1):
-        vm = VoxelMap(0.05, origin, feature_dim=dim)
-        vm.integrate(p[:1000], alpha[:1000], c[:1000], fidx[:1000], phi[:, :dim])  # compile / warm
-        vm = VoxelMap(0.05, origin, feature_dim=dim)
-        t0 = time.perf_counter()
-        vm.integrate(p, alpha, c, fidx, np.ascontiguousarray(phi[:, :dim]))
-        dt = time.perf_counter() - t0
-        rows.append([f"CapNav eq. 5-8 fusion, {dim}-d feature + colour + weight", f"{n:,}", f"{len(vm):,}",
-                     f"{n / dt / 1e6:.1f} M/s"])
+        table = np.ascontiguousarray(phi[:, :dim])
+        VoxelMap(0.05, origin, feature_dim=dim).integrate(p[:1000], alpha[:1000], c[:1000], fidx[:1000], table)
+
+        def fuse(dim: int = dim, table: NDArray[np.float32] = table) -> VoxelMap:
+            vm = VoxelMap(0.05, origin, feature_dim=dim)
+            vm.integrate(p, alpha, c, fidx, table)
+            return vm
+
+        dt, vm = _best_cpu(fuse, repeat)
+        ours[dim] = (dt, len(vm))  # type: ignore[arg-type]
     try:
         import open3d as o3d
     except ImportError:
-        rows.append(["Open3D voxel_down_sample", f"{n:,}", "-", "skipped: open3d not installed "
-                     "(.venv/bin/pip install open3d)"])
-        return rows
+        return [[f"CapNav eq. 5-8 fusion, {d}-d feature + colour + weight", f"{n:,}", f"{v:,}",
+                 f"{n / t / 1e6:.1f} M/s", "skipped: open3d not installed (.venv/bin/pip install open3d)"]
+                for d, (t, v) in ours.items()]
     pcd = o3d.geometry.PointCloud()
     pcd.points = o3d.utility.Vector3dVector(p)
     pcd.colors = o3d.utility.Vector3dVector(c.astype(np.float64) / 255.0)
     pcd.voxel_down_sample(0.05)
-    t0 = time.perf_counter()
-    ds = pcd.voxel_down_sample(0.05)
-    dt = time.perf_counter() - t0
+    dt3, ds = _best_cpu(lambda: pcd.voxel_down_sample(0.05), repeat)
+    rows = []
+    for dim, target in ((64, 0.5), (1, 1.0)):
+        t, v = ours[dim]
+        ratio = dt3 / t
+        rows.append([f"CapNav eq. 5-8 fusion, {dim}-d feature + colour + weight", f"{n:,}", f"{v:,}",
+                     f"{n / t / 1e6:.1f} M/s", f"{ratio:.2f}x Open3D (target >= {target:g}x: "
+                     f"{'met' if ratio >= target else 'NOT met'})"])
     rows.append([f"Open3D {o3d.__version__} voxel_down_sample (colour, one batch call)", f"{n:,}",
-                 f"{len(ds.points):,}", f"{n / dt / 1e6:.1f} M/s"])
+                 f"{len(ds.points):,}", f"{n / dt3 / 1e6:.1f} M/s", "reference"])  # type: ignore[attr-defined]
     return rows
 
 
@@ -300,7 +324,8 @@ def main() -> None:
     _table("simulator detector per frame (instances with >= 100 / >= 2000 visible px)",
            ["noise", "recall >=100px", "recall >=2000px", "label swapped", "false pos./frame", "mean score"],
            detector_stats(frames))
-    _table("voxel fusion on the same points (5 cm voxels)", ["method", "points", "voxels", "points/s"],
+    _table("voxel fusion on the same points (5 cm voxels; min CPU time of 3 runs)",
+           ["method", "points", "voxels", "points/s", "ratio"],
            fusion_vs_open3d(frames))
     _table(f"memory for a whole apartment (seed {args.seeds[0]})", ["what", "size"], memory(args.seeds[0], args.noise))
     sim.close()  # type: ignore[attr-defined]

@@ -95,6 +95,7 @@ class VoxelMap:
         self.dim = int(feature_dim)
         self.text_space = text_space
         self._n = 0
+        self._ck, self._cs = K_.new_cache()  # recent key -> slot; slots never move, so never stale
         self._alloc(max(capacity, 16))
 
     # ---- storage -------------------------------------------------------------------------
@@ -192,12 +193,19 @@ class VoxelMap:
         phi = np.ascontiguousarray(phi, dtype=np.float32)
         if phi.ndim != 2 or phi.shape[1] != self.dim:
             raise InputError(f"feature table must be (M, {self.dim}), got {phi.shape}")
-        keys = K_.pack_keys(self.index_of(points_w))
-        self._reserve(n)
-        self._n = K_.fuse(self._tk, self._tv, self._shift, self._keys, self._w, self._c, self._f, self._n,
-                         keys, np.ascontiguousarray(alpha, dtype=np.float32),
-                         np.ascontiguousarray(colors, dtype=np.uint8),
-                         np.ascontiguousarray(feat_index, dtype=np.int64), phi)
+        p = np.ascontiguousarray(points_w, dtype=np.float64)
+        if p.ndim != 2 or p.shape[1] != 3:
+            raise InputError(f"points must be (N, 3), got {p.shape}")
+        a = np.ascontiguousarray(alpha, dtype=np.float32)
+        rgb = np.ascontiguousarray(colors, dtype=np.uint8)
+        fi = np.ascontiguousarray(feat_index, dtype=np.int64)
+        done = 0
+        while done < n:  # grow with the voxels actually seen (a point is rarely a new voxel)
+            self._reserve(min(n - done, max(self._n // 2, 1 << 14)))
+            limit = min(self._keys.shape[0], self._tk.shape[0] // 2)
+            self._n, done = K_.fuse_points(self._ck, self._cs, self._tk, self._tv, self._shift, self._keys,
+                                           self._w, self._c, self._f, self._n, p, self.origin, self.resolution,
+                                           a, rgb, fi, phi, done, limit)
 
     def integrate_frame(self, depth: NDArray[np.floating], rgb: NDArray[np.uint8], K: Intrinsics,
                         T_wc: NDArray[np.floating], feat_grid: NDArray[np.integer], phi: NDArray[np.float32],
@@ -217,7 +225,8 @@ class VoxelMap:
             raise InputError(f"rgb {rgb.shape} / intrinsics {K.height}x{K.width} do not match depth {depth.shape}")
         self._reserve(len(range(0, h, stride)) * len(range(0, w, stride)))
         intr = np.array([K.fx, K.fy, K.cx, K.cy], dtype=np.float64)
-        self._n = K_.fuse_image(self._tk, self._tv, self._shift, self._keys, self._w, self._c, self._f, self._n,
+        self._n = K_.fuse_image(self._ck, self._cs, self._tk, self._tv, self._shift, self._keys, self._w, self._c,
+                                self._f, self._n,
                                 depth, np.ascontiguousarray(rgb, dtype=np.uint8), intr,
                                 np.ascontiguousarray(T_wc, dtype=np.float64), self.origin, self.resolution,
                                 float(sigma), float(max_depth), int(stride), grid.shape[0], grid.shape[1], grid, phi)
