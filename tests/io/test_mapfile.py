@@ -61,6 +61,10 @@ def test_round_trip_everything(cmap: CapNavMap, tmp_path: Path) -> None:
     assert back.occupancy.spec == cmap.occupancy.spec
     assert back.caches == cmap.caches
     assert back.meta["dataset"] == "synthetic" and back.meta["frames_used"] == 30
+    assert cmap.trajectory is not None and back.trajectory is not None and len(back.trajectory) == 30
+    np.testing.assert_array_equal(back.trajectory.frames, np.arange(30))
+    np.testing.assert_array_equal(back.trajectory.poses, cmap.trajectory.poses)
+    np.testing.assert_array_equal(back.trajectory.poses[-1], orbit(30)[-1].T_wc)  # the last camera, as fused
     # a loaded voxel map still answers slot lookups and queries identically
     np.testing.assert_array_equal(w.slots(v.coords[:50]), np.arange(50))
     q = np.random.default_rng(0).standard_normal(32)
@@ -104,10 +108,21 @@ def test_corrupted_entry_is_named(cmap: CapNavMap, tmp_path: Path) -> None:
         load_map(bad)
 
 
+def test_version_1_without_trajectory_loads(cmap: CapNavMap, tmp_path: Path) -> None:
+    """Maps written before the camera trajectory was stored (version 1: no trajectory/ entries)."""
+    old = CapNavMap(cmap.objects, cmap.voxels, cmap.occupancy, cmap.meta, cmap.caches, trajectory=None)
+    p = save_map(old, tmp_path / "m.capnav")
+    with zipfile.ZipFile(p) as zf:
+        assert not [n for n in zf.namelist() if n.startswith("trajectory/")]
+    v1 = _edited_copy(p, tmp_path / "v1.capnav", "header.json", lambda d: d.replace(b'"version": 2', b'"version": 1'))
+    back = load_map(v1)
+    assert back.trajectory is None and len(back.objects) == len(cmap.objects)
+
+
 def test_wrong_version_and_foreign_files(cmap: CapNavMap, tmp_path: Path) -> None:
     p = save_map(cmap, tmp_path / "m.capnav")
     bad = _edited_copy(p, tmp_path / "v9.capnav", "header.json",
-                       lambda d: d.replace(b'"version": 1', b'"version": 9'))
+                       lambda d: d.replace(b'"version": 2', b'"version": 9'))
     with pytest.raises(MapFileError, match="version 9"):
         load_map(bad)
     txt = tmp_path / "x.capnav"

@@ -1,11 +1,18 @@
-"""``capnav navigate MAP --scene SEED "instruction"``: retrieve, plan with A*, drive, draw."""
+"""``capnav navigate MAP "instruction"``: retrieve, choose a goal pose, plan with A*; drive in the
+simulator when the map comes from ``capnav sim``, else write the goal and path for a robot stack."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
+
+if TYPE_CHECKING:
+    from rich.console import Console
+
+    from capnav.mapping.cmap import CapNavMap
+    from capnav.retrieval import Retriever
 
 
 def register(app: typer.Typer) -> None:
@@ -15,15 +22,19 @@ def register(app: typer.Typer) -> None:
         instruction: Annotated[str, typer.Argument(help='what to go to, e.g. "the white sofa with curved arms"')],
         scene: Annotated[int | None, typer.Option(
             "--scene", help="apartment seed to drive in (default: the seed recorded in the map)")] = None,
-        start: Annotated[str | None, typer.Option(help="start pose X,Y[,YAW] (m, rad); default: seeded random")
+        start: Annotated[str | None, typer.Option(help="start pose X,Y[,YAW] (m, rad); default: the recording's "
+                                                       "last camera pose, or seeded random in the simulator")
                          ] = None,
+        drive: Annotated[bool | None, typer.Option(
+            "--drive/--plan-only", help="drive the simulated agent (default when the map comes from capnav sim) or "
+                                        "only write the goal pose, path and map for a robot stack")] = None,
         seed: Annotated[int, typer.Option(help="seed of the random start")] = 0,
         episode: Annotated[Path | None, typer.Option(
             help="episode file (capnav eval): scene and start pose from its episode --episode-id")] = None,
         episode_id: Annotated[str | None, typer.Option(help="episode id in --episode (default: the first)")
                               ] = None,
-        out: Annotated[Path, typer.Option("--out", "-o", help="folder for navigate.png / navigate.json")] = Path(
-            "runs/navigate"),
+        out: Annotated[Path, typer.Option("--out", "-o", help="folder for navigate.png / .json / _map.pgm+yaml")
+                       ] = Path("runs/navigate"),
         occupancy: Annotated[str, typer.Option(help="plan on the 'mapped' occupancy or the simulator's 'truth'")
                              ] = "mapped",
         embedder: Annotated[str, typer.Option(help="text embedder backend (must match the map's captions)")
@@ -33,21 +44,15 @@ def register(app: typer.Typer) -> None:
         verifier: Annotated[str, typer.Option(help="verification backend: offline, none, gemini, openai, ...")
                             ] = "offline",
     ) -> None:
-        """Go to the object an instruction describes, in a simulated apartment; writes PNG + JSON."""
+        """Go to the object an instruction describes: a goal pose (x, y, yaw facing it) and an A* path in
+        the map's frame (JSON, PNG, ROS map_server PGM + YAML), driven in the simulator for sim maps."""
         from rich.console import Console
 
         from capnav.core.errors import InputError
         from capnav.io.mapfile import load_map
         from capnav.language import create_embedder
-        from capnav.planning.instruction import (
-            OCCUPANCY_KINDS,
-            episode_start,
-            parse_pose,
-            random_start,
-            run_instruction,
-        )
+        from capnav.planning.instruction import OCCUPANCY_KINDS, episode_start, parse_pose
         from capnav.retrieval import Retriever, create_verifier
-        from capnav.sim import Simulator
 
         if occupancy not in OCCUPANCY_KINDS:  # fail before the slow loading below
             raise InputError(f"occupancy must be one of {', '.join(OCCUPANCY_KINDS)}, got {occupancy!r}")
@@ -58,15 +63,25 @@ def register(app: typer.Typer) -> None:
             given = given or ep_pose
         cmap = load_map(map_file)
         scene_seed = next((s for s in (scene, ep_scene, cmap.meta.get("scene_seed")) if s is not None), None)
-        if scene_seed is None:
-            raise InputError(f"{map_file} records no scene seed: pass --scene SEED")
+        if drive and scene_seed is None:
+            raise InputError(f"{map_file} records no scene seed to drive in (a map of a recording): pass --scene "
+                             "SEED, or plan only (the default)")
+        if (drive is False or scene_seed is None) and occupancy != "mapped":
+            raise InputError("--occupancy truth needs the simulator: it applies only when driving (--drive)")
         emb = create_embedder(embedder, **({"path": str(embedder_path)} if embedder_path else {}))
         ver_kw = {"embedder": emb} if verifier == "offline" else {}
         retriever = Retriever(cmap, emb, create_verifier(verifier, **ver_kw))
+        con = Console(stderr=True)
+        if drive is False or scene_seed is None:
+            _plan_only(con, cmap, retriever, instruction, given, out, map_file)
+            return
+        from capnav.io.rosmap import write_ros_map
+        from capnav.planning.instruction import random_start, run_instruction
+        from capnav.sim import Simulator
+
         with Simulator.from_seed(int(scene_seed)) as sim:
             pose = given or random_start(sim, seed)
             res = run_instruction(cmap, sim, retriever, instruction, pose, occupancy, out_dir=out)
-        con = Console(stderr=True)
         q, nav = res.query, res.nav
         con.print(f"chosen: {q.chosen.id if q.chosen else '-'} {q.chosen.caption if q.chosen else ''}", highlight=False)
         con.print(f"why: {q.reason}", highlight=False)
@@ -74,6 +89,30 @@ def register(app: typer.Typer) -> None:
             colour = "green" if nav.reached else "red"
             con.print(f"[{colour}]{'reached' if nav.reached else 'not reached'}[/]: {nav.reason}; "
                       f"path {nav.path_length:.2f} m, {nav.replans} replans", highlight=False)
-        con.print(f"{res.png}\n{res.json}", highlight=False)
+        pgm, yml = write_ros_map(cmap.occupancy, out / "navigate_map.yaml")
+        con.print(f"{res.png}\n{res.json}\n{yml} (+ {pgm.name})", highlight=False)
         if not res.reached:
             raise typer.Exit(1)
+
+
+def _plan_only(con: Console, cmap: CapNavMap, retriever: Retriever, instruction: str,
+               start: tuple[float, float, float] | None, out: Path, map_file: Path) -> None:
+    """No simulator: the goal pose and path on the map, written for a robot stack; exit 1 when there is none."""
+    from capnav.planning.on_map import navigate_on_map, write_outputs
+
+    nav = navigate_on_map(cmap, retriever, instruction, start)
+    q = nav.query
+    con.print(f"start: ({nav.start[0]:.2f}, {nav.start[1]:.2f}, yaw {nav.start[2]:.2f}) from {nav.start_source}",
+              highlight=False)
+    con.print(f"chosen: {q.chosen.id if q.chosen else '-'} {q.chosen.caption if q.chosen else ''}", highlight=False)
+    con.print(f"why: {q.reason}", highlight=False)
+    if nav.goal is not None:
+        g = nav.goal
+        con.print(f"goal pose: x {g.xy[0]:.2f}, y {g.xy[1]:.2f}, yaw {g.yaw:.2f} (map frame of {map_file.name})",
+                  highlight=False)
+    con.print(f"[{'green' if nav.ok else 'red'}]{'planned' if nav.ok else 'no plan'}[/]: {nav.reason}",
+              highlight=False)
+    files = write_outputs(nav, cmap, out)
+    con.print("\n".join(str(files[k]) for k in ("json", "png", "yaml", "pgm")), highlight=False)
+    if not nav.ok:
+        raise typer.Exit(1)

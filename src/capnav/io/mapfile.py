@@ -1,6 +1,6 @@
 """The CapNav map file: one zip archive, no pickle, validated on load.
 
-Layout (format ``capnav-map``, version 1)::
+Layout (format ``capnav-map``, version 2; version 1 files, without the camera trajectory, still load)::
 
     header.json            format, version, and for every other entry: sha256, size, and for
                            arrays their dtype and shape
@@ -10,6 +10,8 @@ Layout (format ``capnav-map``, version 1)::
     objects/<field>.npy    that array field of every object, flattened and concatenated
     views/<o>_<k>_<kind>.png  view PNG bytes (frame / crop)
     voxels/*.npy, occupancy/cells.npy, grids in objects.json / header.json
+    trajectory/frames.npy trajectory/poses.npy   (version 2, when the map recorded one) the
+                           fused frames' indices and camera-to-world poses (N, 4, 4)
 
 Arrays are ``.npy`` written and read with ``allow_pickle=False``. Loading checks the format name,
 the version, every entry's presence, checksum, dtype and shape, and the cross-array consistency;
@@ -33,12 +35,13 @@ from numpy.typing import NDArray
 from capnav.core.atomic import write_with
 from capnav.core.errors import CapNavError, MapFileError
 from capnav.core.grid import GridSpec, OccupancyGrid
-from capnav.mapping.cmap import CapNavMap
+from capnav.mapping.cmap import CameraTrajectory, CapNavMap
 from capnav.mapping.objects import MapObject, ObjectView, Observation
 from capnav.mapping.voxel_map import VoxelMap
 
 FORMAT = "capnav-map"
-VERSION = 1
+VERSION = 2
+READS = (1, 2)  # version 1: the same without trajectory/
 _OBJ_FIELDS = [f.name for f in dataclasses.fields(MapObject)]
 _ARRAY_DTYPES = {"position": np.float64, "extent_min": np.float64, "extent_max": np.float64,
                  "footprint": np.float64, "points": np.float32, "colors": np.uint8, "feature": np.float32,
@@ -107,6 +110,9 @@ def save_map(cmap: CapNavMap, path: str | Path) -> Path:
     if vox.projection is not None:
         blobs["voxels/projection.npy"] = _npy(vox.projection)
     blobs["occupancy/cells.npy"] = _npy(cmap.occupancy.cells)
+    if cmap.trajectory is not None:
+        blobs["trajectory/frames.npy"] = _npy(cmap.trajectory.frames)
+        blobs["trajectory/poses.npy"] = _npy(cmap.trajectory.poses)
     blobs["objects.json"] = _json(records, "an object field")
     blobs["meta.json"] = _json(cmap.meta, "meta")
     blobs["caches.json"] = _json(cmap.caches, "caches")
@@ -197,9 +203,9 @@ def load_map(path: str | Path) -> CapNavMap:
         if not isinstance(header, dict) or header.get("format") != FORMAT:
             fmt = header.get("format") if isinstance(header, dict) else None
             raise MapFileError(f"{p}: not a CapNav map (format {fmt!r}, expected {FORMAT!r})")
-        if header.get("version") != VERSION:
+        if header.get("version") not in READS:
             raise MapFileError(f"{p}: map format version {header.get('version')} is not supported (this CapNav "
-                               f"reads version {VERSION}); rebuild the map with `capnav map`")
+                               f"reads versions {', '.join(map(str, READS))}); rebuild the map with `capnav map`")
         if not isinstance(header.get("entries"), dict):
             raise MapFileError(f"{p}: header has no entry table")
         r = _Reader(p, zf, header)
@@ -267,4 +273,7 @@ def _decode(r: _Reader, header: dict[str, Any]) -> CapNavMap:
     caches = r.json("caches.json")
     if not isinstance(meta, dict) or not isinstance(caches, dict):
         raise r.fail("meta.json and caches.json must hold JSON objects")
-    return CapNavMap(objects=objects, voxels=voxels, occupancy=occ, meta=meta, caches=caches)
+    traj = None
+    if "trajectory/poses.npy" in r.entries:
+        traj = CameraTrajectory(r.array("trajectory/frames.npy"), r.array("trajectory/poses.npy"))
+    return CapNavMap(objects=objects, voxels=voxels, occupancy=occ, meta=meta, caches=caches, trajectory=traj)

@@ -5,10 +5,32 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+from numpy.typing import NDArray
+
 from capnav.core.errors import NotFoundError
 from capnav.core.grid import OccupancyGrid
 from capnav.mapping.objects import MapObject
 from capnav.mapping.voxel_map import VoxelMap
+
+
+@dataclass
+class CameraTrajectory:
+    """Where the camera was: ``frames`` (N,) indices of the frames fused, ``poses`` (N, 4, 4) their
+    camera-to-world poses, in order. Planning on a map of a recording starts from it and treats the
+    floor under it as free (the camera went there)."""
+
+    frames: NDArray[np.int64]
+    poses: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        self.frames = np.asarray(self.frames, dtype=np.int64).reshape(-1)
+        self.poses = np.asarray(self.poses, dtype=np.float64).reshape(-1, 4, 4)
+        if len(self.frames) != len(self.poses):
+            raise ValueError(f"trajectory has {len(self.frames)} frame indices for {len(self.poses)} poses")
+
+    def __len__(self) -> int:
+        return len(self.frames)
 
 
 @dataclass
@@ -22,6 +44,7 @@ class CapNavMap:
     occupancy: OccupancyGrid
     meta: dict[str, Any] = field(default_factory=dict)
     caches: dict[str, dict[str, Any]] = field(default_factory=dict)
+    trajectory: CameraTrajectory | None = None  # None in maps written before it was recorded
 
     def object(self, object_id: int) -> MapObject:
         for o in self.objects:

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 from capnav.core.errors import FrameError, InputError
 from capnav.core.frame import Frame
 from capnav.core.progress import track
-from capnav.mapping.cmap import CapNavMap
+from capnav.mapping.cmap import CameraTrajectory, CapNavMap
 from capnav.mapping.lifting import LiftConfig, LiftedDetection, lift_detection
 from capnav.mapping.memory import MemoryConfig, ObjectMemory
 from capnav.mapping.objects import Observation
@@ -83,6 +83,7 @@ class Mapper:
         self.lift_skips = 0
         self.pose_jumps: list[dict[str, Any]] = []
         self._last_eye: NDArray[np.float64] | None = None
+        self.camera_path: list[tuple[int, NDArray[np.float64]]] = []  # (frame index, T_wc) of every frame fused
         self.seconds = 0.0
 
     def _bad(self, err: FrameError) -> bool:
@@ -142,6 +143,7 @@ class Mapper:
                 log.warning("frame %s: camera moved %.2f m since the previous frame", frame.index, jump)
                 self.pose_jumps.append({"frame": frame.index, "metres": round(jump, 3)})
         self._last_eye = eye
+        self.camera_path.append((int(frame.index), np.asarray(frame.T_wc, dtype=np.float64).copy()))
         vc = self.config.voxel
         proj = self.voxels.project(table) if self.voxels.projection is not None else table
         self.voxels.integrate_frame(frame.depth, frame.rgb, frame.K, frame.T_wc, grid, proj, vc.sigma,
@@ -198,7 +200,9 @@ class Mapper:
             "mapping_seconds": round(self.seconds, 3),
         }
         info.update(meta or {})
-        return CapNavMap(objects=objects, voxels=self.voxels, occupancy=occ, meta=info)
+        path = (CameraTrajectory(np.array([i for i, _ in self.camera_path]), np.stack([T for _, T in self.camera_path]))
+                if self.camera_path else None)
+        return CapNavMap(objects=objects, voxels=self.voxels, occupancy=occ, meta=info, trajectory=path)
 
 
 def build_map(frames: Iterable[Frame], config: MapperConfig | None = None, detector: Detector | None = None,

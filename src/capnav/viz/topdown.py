@@ -44,12 +44,14 @@ def draw_navigation(occ: OccupancyGrid, objects: Sequence[MapObject], chosen_id:
                     path_xy: NDArray[np.floating] | None, trajectory_xy: NDArray[np.floating] | None,
                     start: Pose | None, end: Pose | None, title: str, out_png: str | Path,
                     goal: Pose | None = None, reach: float | None = None, dpi: int = 120,
-                    abandoned: Sequence[NDArray[np.floating]] = ()) -> Path:
+                    abandoned: Sequence[NDArray[np.floating]] = (),
+                    camera_xy: NDArray[np.floating] | None = None) -> Path:
     """Draw the picture and write it atomically to ``out_png``; returns the path.
 
     ``start`` / ``end`` / ``goal`` are (x, y) or (x, y, yaw): with a yaw an arrow shows the heading.
     ``reach`` draws the success radius around the chosen object's footprint; ``abandoned`` are
-    earlier plans given up after a collision (thin dotted), so replanning is visible.
+    earlier plans given up after a collision (thin dotted), so replanning is visible; ``camera_xy``
+    the path of the camera that recorded the map (thin grey).
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -82,6 +84,9 @@ def draw_navigation(occ: OccupancyGrid, objects: Sequence[MapObject], chosen_id:
         if len(q):
             ax.plot(q[:, 0], q[:, 1], ":", color="#7f7f7f", lw=1.1, zorder=4,
                     label="abandoned plan" if k == 0 else None)
+    if camera_xy is not None and len(camera_xy):
+        c = np.asarray(camera_xy, dtype=np.float64)
+        ax.plot(c[:, 0], c[:, 1], "-", color="#8c8c8c", lw=1.0, label="camera path", zorder=3)
     if path_xy is not None and len(path_xy):
         p = np.asarray(path_xy, dtype=np.float64)
         ax.plot(p[:, 0], p[:, 1], "--", color=PATH, lw=1.4, label="planned path", zorder=6)
