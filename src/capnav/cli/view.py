@@ -1,0 +1,48 @@
+"""``capnav view MAP [--query TEXT] -o map.rrd``: the map in 3D for rerun's viewer."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("view")
+    def view_cmd(
+        map_path: Annotated[Path, typer.Argument(help="a map file (capnav map; captions shown when captioned)")],
+        out: Annotated[Path, typer.Option("-o", "--out", help="the .rrd file to write (open it with `rerun FILE`)")
+                       ] = Path("map.rrd"),
+        query: Annotated[list[str] | None, typer.Option(
+            "--query", "-q", help="an instruction to answer and show (repeatable)")] = None,
+        robot: Annotated[str | None, typer.Option(help="robot position X,Y (m): plans a path to each answer")
+                         ] = None,
+        connect: Annotated[str | None, typer.Option(
+            help="send to a running rerun viewer at this gRPC URL instead of writing --out "
+                 "(e.g. rerun+http://127.0.0.1:9876/proxy)")] = None,
+        max_voxels: Annotated[int, typer.Option(min=1, help="voxels logged at most (a seeded subsample beyond)")
+                              ] = 300_000,
+    ) -> None:
+        """Log the voxel map, object boxes with ids and captions, the camera path and answers to rerun."""
+        from rich.console import Console
+
+        from capnav.api import CapNav
+        from capnav.cli.query import parse_xy
+        from capnav.viz.rerun_log import write_rrd
+
+        xy = parse_xy(robot)
+        nav = CapNav.open(map_path)
+        answers = []
+        for text in query or []:
+            ans = nav.ask(text, robot=xy)
+            plan = nav.plan(xy, ans) if xy is not None and ans.goal is not None else None
+            answers.append((ans, plan))
+        path = write_rrd(nav.map, out, answers, connect=connect, max_voxels=max_voxels)
+        con = Console(stderr=True)
+        for ans, plan in answers:
+            got = f"object {ans.object.id}: {ans.object.caption}" if ans.object else "not found"
+            con.print(f'"{ans.instruction}" -> {got}' + (f"; path {plan.length_m:.2f} m" if plan else ""),
+                      highlight=False)
+        con.print(f"{path if path else connect}: {len(nav.map.objects)} objects, {len(nav.map.voxels)} voxels",
+                  highlight=False)
