@@ -28,6 +28,9 @@ def test_demo_runs_the_whole_loop(tmp_path: Path) -> None:
     absent = res.items[2]
     assert absent.correct is not None
     assert "CapNav demo" in html
+    # one id per object: the overview is the map (map ids, as in the answers); the truth picture says it is truth
+    assert (tmp_path / "images" / "map.png").stat().st_size > 1000 and "images/map.png" in html
+    assert "T-numbers are truth ids, not map ids" in html and "images/apartment.png" in html
 
 
 def test_demo_user_instruction_that_matches_nothing(tmp_path: Path) -> None:

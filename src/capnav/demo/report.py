@@ -42,7 +42,14 @@ class Report:
     title: str
     summary: list[tuple[str, str]]  # (label, value) rows
     items: list[ReportItem]
-    overview_png: str | None = None
+    overview_png: str | None = None  # the map CapNav built, objects labelled with their map ids
+    truth_png: str | None = None  # the simulator's apartment, truth ids marked "T" (only where truth is the subject)
+
+
+MAP_CAPTION = ("The map CapNav built: every object boxed and labelled with its map id, the id the answers "
+               "below use.")
+TRUTH_CAPTION = ("The apartment as the simulator built it (its truth, used only to judge the answers): "
+                 "T-numbers are truth ids, not map ids.")
 
 
 def verdict(it: ReportItem) -> str:
@@ -62,7 +69,9 @@ def write_markdown(report: Report, path: Path) -> None:
     lines = [f"# {report.title}", ""]
     lines += ["| | |", "|---|---|"] + [f"| {k} | {v} |" for k, v in report.summary] + [""]
     if report.overview_png:
-        lines += [f"![apartment]({report.overview_png})", ""]
+        lines += [f"![map]({report.overview_png})", "", MAP_CAPTION, ""]
+    if report.truth_png:
+        lines += [f"![apartment]({report.truth_png})", "", TRUTH_CAPTION, ""]
     for i, it in enumerate(report.items, 1):
         lines += [f"## {i}. \"{it.instruction}\"", "", f"*{it.kind}* — **{verdict(it)}**", ""]
         if it.found:
@@ -93,7 +102,11 @@ def write_html(report: Report, path: Path) -> None:
         f"<h1>{e(report.title)}</h1><table>{rows}</table>",
     ]
     if report.overview_png:
-        parts.append(f"<p><img src='{e(report.overview_png)}' style='max-width:600px'></p>")
+        parts.append(f"<figure><img src='{e(report.overview_png)}' style='max-width:600px'>"
+                     f"<figcaption>{e(MAP_CAPTION)}</figcaption></figure>")
+    if report.truth_png:
+        parts.append(f"<figure><img src='{e(report.truth_png)}' style='max-width:600px'>"
+                     f"<figcaption>{e(TRUTH_CAPTION)}</figcaption></figure>")
     for i, it in enumerate(report.items, 1):
         good = (it.correct is not False) and (it.reached is not False)
         parts.append(f"<div class='item'><h2>{i}. &ldquo;{e(it.instruction)}&rdquo;</h2>")

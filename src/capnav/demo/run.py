@@ -93,7 +93,8 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
               f"({time.perf_counter() - t0:.1f} s)")
     from capnav.viz.scene import draw_scene
 
-    draw_scene(sim.manifest, out / "images" / "apartment.png", navigable=sim.navigable())
+    draw_scene(sim.manifest, out / "images" / "apartment.png", navigable=sim.navigable(), id_prefix="T",
+               title=f"apartment seed {cfg.seed} as simulated (truth; T-numbers are truth ids, not map ids)")
 
     t1 = time.perf_counter()
     con.print("[bold]2/4[/] exploring, mapping (SG3DTracker + voxel map), captioning and embedding")
@@ -133,7 +134,11 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
         ("instructions right (truth)", f"{sum(bool(it.correct) for it in judged)} / {len(judged)}"),
         ("time (s)", ", ".join(f"{k} {v:.1f}" for k, v in timings.items())),
     ]
-    report = Report(f"CapNav demo: apartment {cfg.seed}", summary, items, overview_png="images/apartment.png")
+    from capnav.viz.mapimage import map_picture
+
+    write_bytes(out / "images" / "map.png", map_picture(cmap).png)
+    report = Report(f"CapNav demo: apartment {cfg.seed}", summary, items, overview_png="images/map.png",
+                    truth_png="images/apartment.png")
     md, html_path = out / "report.md", out / "report.html"
     write_markdown(report, md)
     write_html(report, html_path)

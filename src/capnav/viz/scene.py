@@ -17,9 +17,12 @@ _ROOM_TINT = {"living room": "#f3ead8", "kitchen": "#e3eef3", "bedroom": "#efe3e
 
 
 def draw_scene(manifest: SceneManifest, path: str | Path, navigable: OccupancyGrid | None = None,
-               trajectory: NDArray[np.floating] | None = None, title: str | None = None, dpi: int = 110) -> Path:
+               trajectory: NDArray[np.floating] | None = None, title: str | None = None, dpi: int = 110,
+               id_prefix: str = "") -> Path:
     """Save a labelled top-down map (PNG). ``navigable`` shades where the agent fits; ``trajectory``
-    (K, 2+) draws a path. North (+y) is up."""
+    (K, 2+) draws a path. North (+y) is up. Objects are labelled with their truth ids, written
+    ``{id_prefix}{id}``: a picture shown beside map pictures marks them (e.g. "T5") so that they
+    are never read as map ids."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -52,7 +55,7 @@ def draw_scene(manifest: SceneManifest, path: str | Path, navigable: OccupancyGr
         fp = np.asarray(o.footprint)
         ax.add_patch(Polygon(fp, closed=True, facecolor=np.asarray(o.color_rgb) / 255.0, edgecolor="black",
                              lw=0.6, alpha=0.9))
-        ax.text(o.center[0], o.center[1], f"{o.id} {o.category}", ha="center", va="center", fontsize=6,
+        ax.text(o.center[0], o.center[1], f"{id_prefix}{o.id} {o.category}", ha="center", va="center", fontsize=6,
                 bbox={"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none", "alpha": 0.7})
     if trajectory is not None and len(trajectory) > 0:
         t = np.asarray(trajectory)
