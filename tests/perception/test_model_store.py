@@ -77,6 +77,10 @@ def test_cli_errors_are_one_line(tmp_path: Path) -> None:
     assert isinstance(r.exception, InputError) and "known: yolo-fastest-1.1-xl" in str(r.exception)
     r = CliRunner().invoke(app, ["models", "install", "yolo-fastest-1.1", "--from", str(tmp_path / "x")])
     assert isinstance(r.exception, InputError) and "not an existing folder" in str(r.exception)
+    (tmp_path / "file").write_text("x")
+    r = CliRunner().invoke(app, ["models", "install", "yolo-fastest-1.1", "--from", str(tmp_path),
+                                 "--dir", str(tmp_path / "file")])
+    assert isinstance(r.exception, InputError) and "cannot use" in str(r.exception)
 
 
 def test_install_from_urls(shared_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -120,7 +120,10 @@ def verify(s: ModelSpec, folder: Path) -> None:
         p = folder / f.name
         if not p.is_file():
             raise ModelError(f"model {s.name}: {p} is missing")
-        got = sha256_file(p)
+        try:
+            got = sha256_file(p)
+        except OSError as e:
+            raise ModelError(f"model {s.name}: cannot read {p}: {e.strerror or e}") from None
         if got != f.sha256:
             raise ModelError(f"model {s.name}: {p} has sha256 {got[:16]}..., expected {f.sha256[:16]}... "
                              f"({p.stat().st_size} bytes; a truncated, corrupt or different file): reinstall with "
@@ -150,40 +153,51 @@ def install(name: str, root: str | Path | None = None, source_dir: str | Path | 
     if src is not None and not src.is_dir():
         raise InputError(f"--from {str(source_dir)!r} is not an existing folder")
     dest_root = models_root(root)
-    dest_root.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{name}.", dir=dest_root))
     try:
-        for f in s.files:
-            if src is not None:
-                if not (src / f.name).is_file():
-                    need = ", ".join(x.name for x in s.files)
-                    raise ModelError(f"model {name}: {src / f.name} is missing (needs {need})")
-                shutil.copyfile(src / f.name, tmp / f.name)
-            else:
-                assert f.url is not None
-                _fetch(f.url, tmp / f.name, timeout)
-        verify(s, tmp)
-        write_json(tmp / RECORD, {
-            "name": s.name, "description": s.description, "licence": s.licence, "source": s.source,
-            "installed_from": str(src.resolve()) if src is not None else "public source URLs",
-            "installed_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-            "files": {f.name: {"sha256": f.sha256, "url": f.url} for f in s.files},
-        })
-        for p in (tmp, *tmp.iterdir()):  # mkdtemp / mkstemp make owner-only files
-            p.chmod(0o755 if p.is_dir() else 0o644)
-        out = dest_root / name
-        old = None
-        if out.exists():
-            old = dest_root / f".{name}.old"
-            shutil.rmtree(old, ignore_errors=True)
-            out.rename(old)
-        tmp.rename(out)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-        return out
+        dest_root.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{name}.", dir=dest_root))
+    except OSError as e:
+        raise InputError(f"cannot use {dest_root} as the model folder: {e.strerror or e}") from None
+    try:
+        return _fill(s, tmp, src, dest_root, timeout)
+    except OSError as e:  # a full disk, a folder we may not write, an unreadable source file
+        raise ModelError(f"cannot install {name} into {dest_root}: {e}") from None
     finally:
         if tmp.exists():
             shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _fill(s: ModelSpec, tmp: Path, src: Path | None, dest_root: Path, timeout: float) -> Path:
+    """Copy or fetch ``s``'s files into ``tmp``, check them, record them, and move ``tmp`` into place."""
+    name = s.name
+    for f in s.files:
+        if src is not None:
+            if not (src / f.name).is_file():
+                need = ", ".join(x.name for x in s.files)
+                raise ModelError(f"model {name}: {src / f.name} is missing (needs {need})")
+            shutil.copyfile(src / f.name, tmp / f.name)
+        else:
+            assert f.url is not None
+            _fetch(f.url, tmp / f.name, timeout)
+    verify(s, tmp)
+    write_json(tmp / RECORD, {
+        "name": s.name, "description": s.description, "licence": s.licence, "source": s.source,
+        "installed_from": str(src.resolve()) if src is not None else "public source URLs",
+        "installed_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+        "files": {f.name: {"sha256": f.sha256, "url": f.url} for f in s.files},
+    })
+    for p in (tmp, *tmp.iterdir()):  # mkdtemp / mkstemp make owner-only files
+        p.chmod(0o755 if p.is_dir() else 0o644)
+    out = dest_root / name
+    old = None
+    if out.exists():
+        old = dest_root / f".{name}.old"
+        shutil.rmtree(old, ignore_errors=True)
+        out.rename(old)
+    tmp.rename(out)
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
+    return out
 
 
 def installed(root: str | Path | None = None) -> list[dict[str, Any]]:
