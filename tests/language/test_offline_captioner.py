@@ -32,14 +32,28 @@ def test_category_from_votes_not_the_last_label():
 
 
 def test_walls_stop_room_cues():
-    """A stove behind a wall does not put the chair in a kitchen; through a door it does."""
+    """A stove behind a wall does not put the chair in a kitchen, nor through a door into another
+    room (rooms are regions of free space); in the same open space it does."""
     chair = make_obj(1, "chair", (2.0, 2.0), (0.5, 0.5, 0.9), (128, 128, 128))
     stove = make_obj(2, "stove", (4.5, 2.0), (0.6, 0.6, 0.9), (190, 192, 196))
     walled = SceneContext([chair, stove], grid_with_wall(0, 0, 7, 5, wall_x=3.3))
     assert walled.room_of(chair) is None and walled.room_of(stove) == "kitchen"
     assert not walled.visible[0, 1]
-    door = SceneContext([chair, stove], grid_with_wall(0, 0, 7, 5, wall_x=3.3, door=(1.5, 2.5)))
-    assert door.room_of(chair) == "kitchen"
+    door = SceneContext([chair, stove], grid_with_wall(0, 0, 7, 5, wall_x=3.3, door=(1.5, 2.4)))
+    assert door.room_of(chair) is None and door.room_of(stove) == "kitchen"
+    assert door.region[0] != door.region[1]
+    assert SceneContext([chair, stove], grid_with_wall(0, 0, 7, 5)).room_of(chair) == "kitchen"
+
+
+def test_an_object_against_a_shared_wall_belongs_to_the_room_it_is_reached_from():
+    """A cabinet whose mapped box pokes through the wall into the bathroom stays in the office."""
+    grid = grid_with_wall(0, 0, 8, 5, wall_x=4.0, door=(3.8, 4.6))
+    desk = make_obj(1, "desk", (1.5, 1.0), (1.2, 0.6, 0.75), (120, 80, 40))
+    cabinet = make_obj(2, "cabinet", (3.7, 2.0), (0.75, 0.5, 0.9), (240, 240, 236))  # box reaches x = 4.08
+    toilet = make_obj(3, "toilet", (5.0, 1.0), (0.4, 0.6, 0.8), (245, 245, 245))
+    bathtub = make_obj(4, "bathtub", (6.8, 3.5), (1.6, 0.7, 0.55), (245, 245, 245))
+    sc = SceneContext([desk, cabinet, toilet, bathtub], grid)
+    assert sc.room_of(cabinet) == "office" and sc.room_of(toilet) == "bathroom"
 
 
 def test_shape_cues():

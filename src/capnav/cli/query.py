@@ -81,8 +81,10 @@ def _print(res: object) -> None:
                   f"{', predicate ' + res.predicate if res.predicate else ''}{dist}", highlight=False)
     con.print(f"  why: {res.reason}", highlight=False)
     if res.ranked:
-        t = Table("id", "label", "similarity", "caption", title="runners-up", title_justify="left")
-        for obj, s in res.ranked:
-            t.add_row(str(obj.id), obj.label, f"{s:.3f}", obj.caption or "")
+        t = Table("id", "label", "score", "caption", "why not", title="runners-up (decision order)",
+                  title_justify="left")
+        for k, (obj, s) in enumerate(res.ranked):
+            why = res.details[k]["why"] if k < len(res.details) else ""
+            t.add_row(str(obj.id), obj.label, f"{s:.3f}", obj.caption or "", why)
         con.print(t)
     con.print("  timings: " + ", ".join(f"{k} {v * 1e3:.1f} ms" for k, v in res.timings.items()), highlight=False)

@@ -47,6 +47,9 @@ class ContextConfig:
     wall_cells: int = 1  # occupied non-object cells on a segment that count as a wall
     object_margin: float = 0.15  # m around object boxes not counted as wall
     los_range: float = 3.0  # m of box gap up to which walls between objects are checked
+    door_width: float = 1.0  # m: interior doorways are narrower, so eroding by half of it parts the rooms
+    min_room_m2: float = 1.0  # m² of eroded core below which a region is not a room of its own
+    region_strong: float = 0.9  # cue score above which a region clearly is that room type (two: open plan)
 
 
 def canonical_label(label: str) -> str:
@@ -83,6 +86,10 @@ class SceneContext:
         self.gap = np.hypot(gap[..., 0], gap[..., 1])
         self.visible = self._line_of_sight()
         self.room_score = self._room_scores()
+        self.region = np.full(n, -1, dtype=np.int64)  # room region per object (-1: no walls known)
+        self.region_rooms: dict[int, tuple[str | None, dict[str, float]]] = {}
+        if self.occupancy is not None and n:
+            self._regions()
         self.rooms = [self._room(i) for i in range(n)]
 
     def _room_scores(self) -> NDArray[np.float64]:
@@ -117,6 +124,38 @@ class SceneContext:
                 d = np.where(self.visible[:, members], eu, np.inf).min(axis=1)
             score[:, r] = np.maximum(score[:, r], w * np.exp(-0.5 * (d / sigma) ** 2))
         return score
+
+    def _regions(self) -> None:
+        """Rooms from the free space: each object belongs to the region it is reached from, and a
+        region's type is what its cue objects say together (noisy-or of their weights per type).
+        A region whose cues name two types strongly (an open plan) keeps the per-object
+        distance-based scores."""
+        from capnav.language.rooms import object_region, segment_rooms, walkable_domain
+
+        assert self.occupancy is not None
+        spec = self.occupancy.spec
+        labels = segment_rooms(walkable_domain(self.occupancy, self.lo, self.hi), spec,
+                               self.config.door_width, self.config.min_room_m2)
+        if labels.max() < 1:
+            return  # one region or none: the walls say nothing about rooms
+        self.region = np.array([object_region(labels, spec, lo, hi) for lo, hi in zip(self.lo, self.hi, strict=True)],
+                               dtype=np.int64)
+        for k in sorted({int(r) for r in self.region} - {-1}):
+            members = np.flatnonzero(self.region == k)
+            scores = {}
+            for room, cues in ROOM_CUES.items():
+                miss = np.prod([1.0 - cues[self.labels[i]] for i in members if self.labels[i] in cues])
+                scores[room] = float(1.0 - miss)
+            strong = [r for r, v in scores.items() if v >= self.config.region_strong]
+            best, val = max(scores.items(), key=lambda kv: kv[1])
+            if len(strong) > 1 and self.config.region_strong <= 1.0:
+                self.region_rooms[k] = (None, scores)  # an open plan: decide per object
+            else:
+                self.region_rooms[k] = (best if val >= self.config.room_min_score else None, scores)
+        for i, reg in enumerate(self.region):
+            typed = self.region_rooms.get(int(reg))
+            if typed is not None and typed[0] is not None:
+                self.room_score[i] = np.array([typed[1][r] for r in ROOM_CUES])
 
     # -- walls ---------------------------------------------------------------------------------
     def _wall_mask(self) -> NDArray[np.bool_] | None:
@@ -168,6 +207,11 @@ class SceneContext:
         return {room: float(v) for room, v in zip(ROOM_CUES, self.room_score[i], strict=True)}
 
     def _room(self, i: int) -> str | None:
+        typed = self.region_rooms.get(int(self.region[i]))
+        if typed is not None and typed[0] is not None:
+            return typed[0]
+        if typed is not None and all(v < self.config.room_min_score for v in typed[1].values()):
+            return None  # a region without any cue (a hallway): nearby rooms' cues do not claim it
         scores = self.room_scores(i)
         room, best = max(scores.items(), key=lambda kv: kv[1])
         return room if best >= self.config.room_min_score else None

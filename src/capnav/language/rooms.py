@@ -119,3 +119,58 @@ def box_min(field: NDArray[np.float64], spec: GridSpec, lo: NDArray[np.floating]
             if np.isfinite(v):
                 return v + grow
     return float("inf")
+
+
+def segment_rooms(domain: NDArray[np.bool_], spec: GridSpec, door_width: float = 1.0,
+                  min_core_m2: float = 1.0) -> NDArray[np.int32]:
+    """Rooms as regions of the walkable domain: label per cell (-1 outside the domain).
+
+    Interior doors are narrower than ``door_width``: eroding the domain by half of it closes every
+    doorway (and any leak through a box that pokes through a wall), so each room's interior is one
+    connected core. Cores smaller than ``min_core_m2`` are dropped; every other domain cell then
+    goes to the core it is walked to first (one geodesic per core), so a doorway, a corridor too
+    narrow for a core and the space under furniture belong to the room they open into."""
+    from scipy import ndimage
+
+    r = int(np.ceil(0.5 * door_width / spec.resolution))
+    yy, xx = np.mgrid[-r:r + 1, -r:r + 1]
+    core = ndimage.binary_erosion(domain, structure=(xx**2 + yy**2) <= r * r, border_value=0)
+    lab, n = ndimage.label(core)
+    labels = np.full(domain.shape, -1, dtype=np.int32)
+    if n == 0:
+        return labels
+    sizes = ndimage.sum_labels(core, lab, index=np.arange(1, n + 1)) * spec.resolution**2
+    best = np.full(domain.shape, np.inf)
+    k = 0
+    for j in np.flatnonzero(sizes >= min_core_m2):
+        rr, cc = np.nonzero(lab == j + 1)
+        d = _dijkstra(domain, np.stack([rr, cc], axis=1).astype(np.int64), np.inf)
+        closer = d < best
+        labels[closer] = k
+        best[closer] = d[closer]
+        k += 1
+    return labels
+
+
+def object_region(labels: NDArray[np.int32], spec: GridSpec, lo: NDArray[np.floating], hi: NDArray[np.floating],
+                  ring: float = 0.3) -> int:
+    """The room region an object is reached from: the most frequent label of the walkable cells
+    in a ring around its box (the inner half of the box counts too), -1 when none."""
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    r0, c0, r1, c1 = box_cells(spec, lo - ring, hi + ring)
+    if r1 < r0 or c1 < c0:
+        return -1
+    patch = labels[r0:r1 + 1, c0:c1 + 1]
+    q = 0.25 * (hi - lo)
+    i0, j0, i1, j1 = box_cells(spec, lo + q, hi - q)
+    weights = np.ones(patch.shape)
+    b0, b1, d0, d1 = max(i0 - r0, 0), max(i1 - r0 + 1, 0), max(j0 - c0, 0), max(j1 - c0 + 1, 0)
+    # Cells under the box's outer rim may lie beyond the wall it stands against: they do not vote.
+    fr0, fc0, fr1, fc1 = box_cells(spec, lo, hi)
+    weights[max(fr0 - r0, 0):max(fr1 - r0 + 1, 0), max(fc0 - c0, 0):max(fc1 - c0 + 1, 0)] = 0.0
+    weights[b0:b1, d0:d1] = 1.0
+    valid = patch >= 0
+    if not valid.any():
+        return -1
+    votes = np.bincount(patch[valid], weights=weights[valid])
+    return int(np.argmax(votes)) if votes.max() > 0 else -1

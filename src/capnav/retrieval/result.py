@@ -14,13 +14,25 @@ class QueryResult:
     chosen: MapObject | None
     found: bool
     score: float  # cosine similarity of the chosen object's caption (eq. 16), 0 when not found
-    ranked: list[tuple[MapObject, float]]  # runners-up in retrieval order with their cosine
+    ranked: list[tuple[MapObject, float]]  # runners-up in decision order with their final score
     predicate: str | None  # "closest", "farthest", "largest", "smallest", "next to", "room", or None
     reason: str
     timings: dict[str, float] = field(default_factory=dict)  # seconds: embed, rank, verify
     mode: str = "semantic"
     distance_m: float | None = None  # robot to goal in the grid (eq. 17) when a robot position is known
     query: dict[str, Any] = field(default_factory=dict)
+    #: Per runner-up: its terms (similarity, colour agreement, distance, ...) and why it lost.
+    details: list[dict[str, Any]] = field(default_factory=list)
+    terms: dict[str, float] = field(default_factory=dict)  # the chosen object's terms
+
+    def runners_up(self) -> list[dict[str, Any]]:
+        out = []
+        for k, (o, s) in enumerate(self.ranked):
+            d = self.details[k] if k < len(self.details) else {}
+            out.append({"id": o.id, "label": o.label, "caption": o.caption,
+                        "position": [round(float(v), 4) for v in o.position], "score": round(s, 6),
+                        **({"terms": d["terms"], "why": d["why"]} if d else {})})
+        return out
 
     def to_dict(self) -> dict[str, Any]:
         def obj(o: MapObject) -> dict[str, Any]:
@@ -33,7 +45,8 @@ class QueryResult:
             "score": round(self.score, 6), "predicate": self.predicate, "mode": self.mode,
             "distance_m": None if self.distance_m is None else round(self.distance_m, 4),
             "reason": self.reason,
-            "runners_up": [{**obj(o), "score": round(s, 6)} for o, s in self.ranked],
+            "terms": self.terms,
+            "runners_up": self.runners_up(),
             "timings": {k: round(v, 6) for k, v in self.timings.items()},
             "query": self.query,
         }

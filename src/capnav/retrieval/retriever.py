@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -28,10 +29,24 @@ from capnav.retrieval.config import RetrievalConfig
 from capnav.retrieval.query import ParsedQuery, parse_instruction
 from capnav.retrieval.ranking import cosine_scores, mmr, top_k
 from capnav.retrieval.result import QueryResult
-from capnav.retrieval.verifier import AcceptFirst, Candidate, OfflineVerifier, Verifier, a
+from capnav.retrieval.verifier import AcceptFirst, Assessment, Candidate, OfflineVerifier, Verifier, a
 
 _VOCAB = set(NAMES)
 _ROOMS = list(ROOM_CUES)
+_ORDINALS = {2: "second", 3: "third", 4: "fourth", 5: "fifth"}
+
+
+@dataclass
+class Ranking:
+    """The retrieval order with what decided it."""
+
+    order: NDArray[np.intp]  # candidate indices, best first
+    groups: NDArray[np.int64]  # per position: predicate group (ties on the predicate share one)
+    mode: str  # "semantic", "predicate" or "closest"
+    predicate: str | None
+    weights: NDArray[np.float64]  # per object: category weight (1 named, < 1 alternative)
+    terms: dict[int, dict[str, float]]  # per candidate: the predicate's values (distance, volume, ...)
+    refusal: str | None = None  # a reason to answer "not found" before verification
 
 
 def check_map_embeddings(objects: Sequence[MapObject], embedder: TextEmbedder) -> None:
@@ -80,9 +95,12 @@ class Retriever:
         offline = getattr(self.verifier, "fallback", None)
         if isinstance(self.verifier, OfflineVerifier):
             offline = self.verifier
-        if isinstance(offline, OfflineVerifier):
-            offline.bind(embedder, self.scene)
-            offline.use_attributes(cmap.caches.get("attributes", {}))
+        if not isinstance(offline, OfflineVerifier):
+            offline = OfflineVerifier()
+        offline.bind(embedder, self.scene)
+        offline.use_attributes(cmap.caches.get("attributes", {}))
+        #: Judges candidates for explanations, negations and landmarks whatever the verifier is.
+        self.judge: OfflineVerifier = offline
         cache = cmap.caches.setdefault("verifications", {})
         if hasattr(self.verifier, "cache") and getattr(self.verifier, "cache", None) == {}:
             self.verifier.cache = cache
@@ -103,89 +121,213 @@ class Retriever:
     def _of_category(self, cat: str) -> NDArray[np.intp]:
         return np.flatnonzero(self.cats_arr == cat)
 
+    def _category_weights(self, q: ParsedQuery) -> NDArray[np.float64]:
+        """Per object: 1 for the named category, the parser's weight for an alternative, else 0."""
+        w = np.zeros(len(self.objects))
+        for cat, weight in q.category_alternatives.items():
+            w[self._of_category(canonical_label(cat))] = np.maximum(w[self._of_category(canonical_label(cat))],
+                                                                     float(weight))
+        if q.category is not None:
+            w[self._of_category(q.category)] = 1.0
+        return w
+
+    def _negated(self, q: ParsedQuery, i: int) -> str | None:
+        """The negation phrase object ``i`` matches ("not the white one"), else None."""
+        o = self.objects[i]
+        for phrase in q.negations:
+            try:
+                nq = parse_instruction(phrase)
+            except InputError:
+                continue
+            checks: list[bool] = []
+            if nq.category is not None and nq.category != q.category and not nq.colors and not nq.room:
+                continue  # "not the one at the end of the table": a relation this reader does not judge
+            if nq.category is not None and nq.category == q.category:
+                checks.append(self.cats[i] == nq.category)
+            if nq.colors:
+                col, _ = self.judge.color(nq, o)
+                checks.append(col >= self.judge.config.color_match)
+            if nq.room is not None:
+                checks.append(self.scene.rooms[i] == nq.room)
+            if nq.shapes and o.caption:
+                checks.append(all(s.lower() in o.caption.lower() for s in nq.shapes))
+            if checks and all(checks):
+                return phrase
+        return None
+
+    def _anchors(self, q: ParsedQuery, notes: list[str]) -> NDArray[np.intp]:
+        """The landmark's instances, resolved first: of its category, and when its phrase says a
+        colour or a room, only the instance(s) that fit best ("the yellow lamp")."""
+        assert q.anchor_category is not None
+        anchors = self._of_category(q.anchor_category)
+        if len(anchors) < 2 or not q.anchor_phrase:
+            return anchors
+        try:
+            aq = parse_instruction(q.anchor_phrase)
+        except InputError:
+            return anchors
+        if aq.colors:
+            agree = np.array([self.judge.color(aq, self.objects[k])[0] for k in anchors])
+            keep = anchors[agree >= max(self.judge.config.color_reject, agree.max() - 0.05)]
+            notes.append(f"landmark '{q.anchor_phrase}': object {', '.join(str(self.objects[k].id) for k in keep)}")
+            anchors = keep
+        if aq.room is not None:
+            inroom = anchors[[self.scene.rooms[k] == aq.room for k in anchors]]
+            anchors = inroom if len(inroom) else anchors
+        return anchors
+
     def _order(self, q: ParsedQuery, s: NDArray[np.float32], robot_xy: tuple[float, float] | None,
-               notes: list[str]) -> tuple[NDArray[np.intp], str, str | None]:
+               notes: list[str]) -> Ranking:
         cfg = self.config
-        pool = np.arange(len(self.objects))
-        if q.category is not None and cfg.use_type_filter:
-            typed = self._of_category(q.category)
-            if len(typed):
-                pool = typed
-                notes.append(f"{len(typed)} {q.category}(s) in the map")
-            else:
-                notes.append(f"no object in the map is captioned or labelled {q.category}")
-        keys: list[NDArray[np.float64]] = []
+        n = len(self.objects)
+        weights = self._category_weights(q) if cfg.use_type_filter else np.zeros(n)
+        named = q.category is not None or bool(q.category_alternatives)
+        pool = np.flatnonzero(weights > 0)
+        if named and cfg.use_type_filter and len(pool):
+            tier1 = int((weights[pool] >= 1.0).sum())
+            what = q.category or q.purpose or "target"
+            notes.append(f"{tier1} {what}(s) in the map" + (f", {len(pool) - tier1} alternative(s) "
+                                                             f"({', '.join(sorted(q.category_alternatives))})"
+                                                             if len(pool) > tier1 else ""))
+        else:
+            if named and cfg.use_type_filter:
+                notes.append(f"no object in the map is captioned or labelled {q.category or 'as one of '}"
+                             + ("" if q.category else ", ".join(sorted(q.category_alternatives))))
+            pool = np.arange(n)
+            weights = np.ones(n)
+        refusal: str | None = None
+        if q.negations and len(pool):
+            neg = {int(i): self._negated(q, int(i)) for i in pool}
+            dropped = [i for i, p in neg.items() if p is not None]
+            if dropped:
+                notes.append("excluded by the negation: " + ", ".join(
+                    f"object {self.objects[i].id} ({neg[i]})" for i in dropped))
+                pool = np.array([i for i in pool if neg[int(i)] is None], dtype=np.intp)
+                if not len(pool):
+                    refusal = f"every candidate matches what the instruction excludes ({'; '.join(q.negations)})"
+        group_keys: list[NDArray[np.float64]] = [-weights[pool]]
+        order_keys: list[NDArray[np.float64]] = []
         predicate: str | None = None
         mode = "semantic"
-        if cfg.use_predicates and q.room is not None:
-            in_room = np.array([self.scene.rooms[i] == q.room for i in pool], dtype=np.float64)
-            # Inferred room first, then the strength of that room's cues (when none qualifies).
+        values: dict[str, NDArray[np.float64]] = {}
+        if cfg.use_predicates and q.room is not None and q.room in _ROOMS and len(pool):
+            rooms = [self.scene.rooms[i] for i in pool]
+            in_room = np.array([r == q.room for r in rooms], dtype=np.float64)
+            unknown = np.array([r is None for r in rooms], dtype=np.float64)
             strength = self.scene.room_score[pool, _ROOMS.index(q.room)]
-            keys.append(-(in_room + np.round(strength, 2)))
+            # Inferred room first, then objects of no inferred room, then the strength of the cues.
+            group_keys.insert(0, -(2 * in_room + unknown))  # the room before the category tier
+            order_keys.append(-strength)
+            values["room cue"] = strength
             predicate, mode = "room", "predicate"
             notes.append(f"{int(in_room.sum())} of them appear to be in the {q.room} (inferred from nearby objects)")
-        if cfg.use_predicates and q.relation is not None and q.anchor_category is not None:
-            anchors = self._of_category(q.anchor_category)
+            if not in_room.any() and not unknown.any():
+                where = sorted({str(r) for r in rooms})
+                refusal = (f"no {q.category or q.target_phrase} stands in the {q.room}; "
+                           f"{'they are' if len(pool) > 1 else 'it is'} in the {', the '.join(where)}")
+        elif q.room is not None and q.room not in _ROOMS:
+            notes.append(f"rooms of type '{q.room}' are not inferred from the map; the room was not used")
+        if cfg.use_predicates and (q.relation is not None or q.proximity_to_anchor) and q.anchor_category is not None:
+            anchors = self._anchors(q, notes)
             if len(anchors):
                 gap = self.scene.gap[np.ix_(pool, anchors)]
                 same = pool[:, None] == anchors[None, :]
                 gap = np.where(same, np.inf, gap).min(axis=1)
-                keys.append(np.round(gap / 0.25))  # quarter-metre bins, similarity breaks ties
-                predicate, mode = q.relation, "predicate"
+                values["gap to landmark (m)"] = gap
+                if q.proximity_to_anchor and q.proximity is not None:
+                    # "the chair closest to the table": distance to the landmark, exactly.
+                    centre = np.linalg.norm(self.scene.xy[pool][:, None] - self.scene.xy[anchors][None], axis=2)
+                    centre = np.where(same, np.inf, centre).min(axis=1)
+                    far = q.proximity == "farthest"
+                    group_keys.append(-centre if far else centre)
+                    predicate = f"{q.proximity} to the {q.anchor_category}"
+                else:
+                    group_keys.append(np.round(gap / 0.25))  # quarter-metre bins, attributes break ties
+                    predicate = q.relation
+                mode = "predicate"
             else:
                 notes.append(f"no {q.anchor_category} in the map to be {q.relation}")
         if cfg.use_predicates and q.superlative is not None:
             vol = self.volume[pool]
-            keys.append(-vol if q.superlative == "largest" else vol)
+            group_keys.append(-vol if q.superlative == "largest" else vol)
+            values["volume (m3)"] = vol
             predicate, mode = q.superlative, "predicate"
         implicit = q.category_only and robot_xy is not None
         closest = cfg.use_attribute_heuristic and (q.proximity is not None or implicit)
-        if closest and not keys:
+        # Distance to the robot orders what no relation or superlative ordered (within the room).
+        if closest and predicate in (None, "room"):
             if robot_xy is None:
                 notes.append(f"'{q.proximity}' needs a robot position (--robot X,Y); ranked by similarity instead")
             else:
                 d = self.grid_distance(robot_xy)[pool]
                 far = q.proximity == "farthest"
-                keys.append(-d if far else d)
+                group_keys.append(-d if far else d)
+                values["distance to robot (m)"] = d
                 predicate, mode = ("farthest" if far else "closest"), "closest"
-        if not keys:
-            order = pool[np.lexsort((pool, -s[pool]))]
-            order = top_k(s, cfg.top_k, order)
-            if cfg.use_mmr:
-                order = mmr(self.E, s, order, cfg.mmr_lambda)
-            return order, mode, predicate
-        # Lexicographic: first key most significant; similarity then index break ties.
-        sort_keys: list[NDArray[np.float64]] = [pool.astype(np.float64), -s[pool].astype(np.float64)]
-        sort_keys += list(reversed(keys))
-        order = pool[np.lexsort(sort_keys)]
-        return order, mode, predicate
+        sim = s[pool].astype(np.float64)
+        if mode == "semantic":
+            # Per category tier (named category, then alternatives), similarity with MMR.
+            parts = []
+            for w in sorted(set(weights[pool].tolist()), reverse=True):
+                tier = pool[weights[pool] == w]
+                sub = top_k(s, cfg.top_k, tier[np.lexsort((tier, -s[tier]))])
+                parts.append(mmr(self.E, s, sub, cfg.mmr_lambda) if cfg.use_mmr else sub)
+            order = np.concatenate(parts) if parts else pool
+            tier_of = {int(i): k for k, w in enumerate(sorted(set(weights[pool].tolist()), reverse=True))
+                       for i in pool[weights[pool] == w]}
+            groups = np.array([tier_of[int(i)] for i in order], dtype=np.int64)
+        else:
+            # Lexicographic: first group key most significant; then order keys, similarity, index.
+            keys = [pool.astype(np.float64), -sim, *reversed(order_keys), *reversed(group_keys)]
+            perm = np.lexsort(keys)
+            order = pool[perm]
+            gk = np.stack([k[perm] for k in group_keys], axis=1)
+            change = np.r_[True, np.any(gk[1:] != gk[:-1], axis=1)] if len(gk) else np.zeros(0, bool)
+            groups = np.cumsum(change) - 1
+        at = {int(i): k for k, i in enumerate(pool)}
+        terms = {int(i): {name: float(v[at[int(i)]]) for name, v in values.items()} for i in pool}
+        if q.ordinal and q.ordinal > 1 and mode != "semantic" and len(order):
+            skip = order[: q.ordinal - 1]
+            notes.append(f"'{_ORDINALS.get(q.ordinal, str(q.ordinal))}': passed over "
+                         + ", ".join(f"object {self.objects[i].id}" for i in skip))
+            order, groups = order[q.ordinal - 1:], groups[q.ordinal - 1:]
+        return Ranking(order, groups, mode, predicate, weights, terms, refusal)
 
     # -- query ---------------------------------------------------------------------------------
-    def query(self, instruction: str, robot_xy: tuple[float, float] | None = None) -> QueryResult:
+    def query(self, instruction: str | ParsedQuery, robot_xy: tuple[float, float] | None = None) -> QueryResult:
+        """Answer an instruction (text, or an already parsed ``ParsedQuery``)."""
         cfg = self.config
         if robot_xy is not None:
             xy = np.asarray(robot_xy, dtype=np.float64)
             if xy.shape != (2,) or not np.all(np.isfinite(xy)):
                 raise InputError(f"robot position must be two finite numbers x, y, got {robot_xy!r}")
-        q = parse_instruction(instruction)
+        q = instruction if isinstance(instruction, ParsedQuery) else parse_instruction(instruction)
         t0 = time.perf_counter()
         e_q = self.embedder.embed([q.text])[0]
         t1 = time.perf_counter()
         s = cosine_scores(self.E, e_q)
         notes: list[str] = []
-        order, mode, predicate = self._order(q, s, robot_xy, notes)
+        rk = self._order(q, s, robot_xy, notes)
+        order, mode, predicate = rk.order, rk.mode, rk.predicate
         t2 = time.perf_counter()
         chosen_i: int | None = None
         verdict_reason = ""
         verifier = self.verifier if cfg.use_verifier else AcceptFirst()
-        if q.category is not None and cfg.use_type_filter and not len(self._of_category(q.category)) \
-                and isinstance(verifier, AcceptFirst):
+        judged: dict[int, Assessment] = {}
+        limit = cfg.batch_size * cfg.max_batches
+        if rk.refusal is not None:
+            verdict_reason = rk.refusal
+        elif q.category is not None and cfg.use_type_filter and not len(self._of_category(q.category)) \
+                and not q.category_alternatives and isinstance(verifier, AcceptFirst):
             verdict_reason = f"no {q.category} in the map"
         else:
-            cands = order[: cfg.batch_size * cfg.max_batches] if mode != "semantic" else order
-            for b in range(0, min(len(cands), cfg.batch_size * cfg.max_batches), cfg.batch_size):
+            cands = order[:limit] if mode != "semantic" else order
+            for b in range(0, min(len(cands), limit), cfg.batch_size):
                 idx = cands[b:b + cfg.batch_size]
-                batch = [Candidate(self.objects[i], float(s[i]), b + k) for k, i in enumerate(idx)]
+                batch = [Candidate(self.objects[i], float(s[i]), b + k, int(rk.groups[b + k]),
+                                   float(rk.weights[i])) for k, i in enumerate(idx)]
+                for k, c in enumerate(batch):
+                    judged[int(idx[k])] = self.judge.assess(q, c, k / max(len(batch), 1))
                 v = verifier.verify(q, batch)
                 verdict_reason = v.reason
                 if v.index is not None:
@@ -197,30 +339,95 @@ class Retriever:
                 chosen_i = None
         t3 = time.perf_counter()
         timings = {"embed": t1 - t0, "rank": t2 - t1, "verify": t3 - t2}
-        runners = [(self.objects[i], float(s[i])) for i in order[: cfg.runners_up + 1] if i != chosen_i]
-        runners = runners[: cfg.runners_up]
+        runners = self._runners_up(rk, s, judged, chosen_i)
         dist = None
         if robot_xy is not None and chosen_i is not None:
             dist = float(self.grid_distance(robot_xy)[chosen_i])
-        reason = self._explain(q, chosen_i, s, mode, predicate, notes, verdict_reason, dist, verifier)
+        reason = self._explain(q, chosen_i, s, rk, notes, verdict_reason, dist, verifier, runners, judged)
         return QueryResult(q.text, self.objects[chosen_i] if chosen_i is not None else None, chosen_i is not None,
-                           float(s[chosen_i]) if chosen_i is not None else 0.0, runners, predicate, reason, timings,
-                           mode, dist, q.to_dict())
+                           float(s[chosen_i]) if chosen_i is not None else 0.0,
+                           [(self.objects[i], sc) for i, sc, _, _ in runners], predicate, reason, timings,
+                           mode, dist, q.to_dict(), [{"terms": t, "why": w} for _, _, t, w in runners],
+                           judged[chosen_i].terms if chosen_i in judged else {})
 
-    def _explain(self, q: ParsedQuery, i: int | None, s: NDArray[np.float32], mode: str, predicate: str | None,
-                 notes: list[str], verdict: str, dist: float | None, verifier: Verifier) -> str:
+    def _final(self, rk: Ranking, judged: dict[int, Assessment]) -> list[int]:
+        """Every ranked candidate in the order the decision considered them: by predicate group,
+        then (accepted first) by the verifier's value; unjudged ones after, in retrieval order."""
+        pos = {int(i): k for k, i in enumerate(rk.order)}
+        group = {int(i): int(g) for i, g in zip(rk.order, rk.groups, strict=True)}
+
+        def key(i: int) -> tuple[int, int, float, int]:
+            a_ = judged.get(i)
+            if a_ is None:
+                return (1, group[i], 0.0, pos[i])
+            return (0 if a_.ok else 1, group[i], -a_.value, pos[i])
+
+        return sorted((int(i) for i in rk.order), key=key)
+
+    def _runners_up(self, rk: Ranking, s: NDArray[np.float32], judged: dict[int, Assessment],
+                    chosen: int | None) -> list[tuple[int, float, dict[str, float], str]]:
+        """(index, final score, terms, why it lost) of the next candidates, in decision order.
+        The final score is the verifier's value when it judged the candidate, else similarity."""
+        out = []
+        best = judged.get(chosen) if chosen is not None else None
+        for i in self._final(rk, judged):
+            if i == chosen:
+                continue
+            a_ = judged.get(i)
+            terms = dict(a_.terms) if a_ is not None else {"similarity": round(float(s[i]), 3)}
+            terms.update({k: round(v, 3) for k, v in rk.terms.get(i, {}).items()})
+            if a_ is not None and not a_.ok:
+                why = f"rejected: {a_.reason}"
+            elif a_ is None:
+                why = "not verified (a candidate before it was accepted)" if chosen is not None else "not verified"
+            else:
+                why = self._difference(a_, best, rk, i, chosen)
+            score = a_.value if a_ is not None else float(s[i])
+            out.append((i, float(score), terms, why))
+            if len(out) >= self.config.runners_up:
+                break
+        return out
+
+    def _difference(self, a_: Assessment, best: Assessment | None, rk: Ranking, i: int, chosen: int | None) -> str:
+        """The terms in which the chosen candidate beat this one."""
+        if best is None or chosen is None:
+            return f"acceptable (score {a_.value:.2f})"
+        group = {int(k): int(g) for k, g in zip(rk.order, rk.groups, strict=True)}
+        if group.get(i, 0) > group.get(chosen, 0):
+            pred = rk.terms.get(i, {})
+            mine = rk.terms.get(chosen, {})
+            diffs = [f"{k} {pred[k]:.2f} vs {mine[k]:.2f}" for k in pred if k in mine and abs(pred[k] - mine[k]) > 1e-6]
+            return f"ranked after it by {rk.predicate or 'category'}" + (f" ({'; '.join(diffs)})" if diffs else "")
+        diffs = [f"{k} {a_.terms[k]:.2f} vs {best.terms[k]:.2f}" for k in a_.terms
+                 if k in best.terms and k != "similarity" and a_.terms[k] < best.terms[k] - 1e-6]
+        return f"lower score {a_.value:.2f} vs {best.value:.2f}" + (f" ({'; '.join(diffs)})" if diffs else "")
+
+    def _explain(self, q: ParsedQuery, i: int | None, s: NDArray[np.float32], rk: Ranking, notes: list[str],
+                 verdict: str, dist: float | None, verifier: Verifier,
+                 runners: list[tuple[int, float, dict[str, float], str]], judged: dict[int, Assessment]) -> str:
         target = q.target_phrase or q.text
         if i is None:
             base = f"Not found: nothing in the map is {a(target)}"
-            return f"{base} ({verdict})." + (f" {'; '.join(notes)}." if notes else "")
+            text = f"{base} ({verdict})."
+            if runners:
+                text += " Closest candidates: " + "; ".join(
+                    f"object {self.objects[k].id} ({self.cats[k]}, score {sc:.2f}) {why}"
+                    for k, sc, _, why in runners[:3]) + "."
+            return text + (f" {'; '.join(notes)}." if notes else "")
         o = self.objects[i]
-        how = {"closest": f"it is the {predicate} {q.category or target} to the robot"
-                          + (f" ({dist:.1f} m in the grid)" if dist is not None else ""),
-               "predicate": f"it best satisfies '{predicate}'", "semantic": "its caption is the most similar"}[mode]
+        mode, predicate = rk.mode, rk.predicate
+        if mode == "closest":
+            how = f"it is the {predicate} {q.category or target} to the robot" \
+                  + (f" ({dist:.1f} m in the grid)" if dist is not None else "")
+        elif mode == "predicate":
+            how = f"it best satisfies '{predicate}'"
+        elif i in judged and judged[i].ok:
+            how = f"it has the highest verification score ({judged[i].value:.2f})"
+        else:
+            how = "it is the first candidate in the similarity ranking"
         text = f"Chose object {o.id} ({o.caption}) because {how}; caption similarity {s[i]:.2f}"
         if verdict:
             text += f"; verifier ({verifier.name}): {verdict}"
         if notes:
             text += f". Notes: {'; '.join(notes)}"
         return text + "."
-

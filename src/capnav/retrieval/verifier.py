@@ -48,6 +48,21 @@ class Candidate:
     obj: MapObject
     score: float  # cosine similarity (eq. 16)
     rank: int  # position in the retrieval order
+    #: Candidates of one group tie on the retrieval's predicate (same room tier, same quarter-metre
+    #: of distance to the landmark, same category tier): only within the lowest group with an
+    #: acceptable candidate may attributes reorder them, so a size word cannot override a relation.
+    group: int = 0
+    weight: float = 1.0  # 1 for the named category, below 1 for an alternative ("armchair" for "chair")
+
+
+@dataclass
+class Assessment:
+    """The offline verifier's judgement of one candidate: accepted or not, its value and terms."""
+
+    ok: bool
+    value: float
+    terms: dict[str, float]
+    reason: str
 
 
 def target_description(q: ParsedQuery) -> str:
@@ -90,12 +105,24 @@ class AcceptFirst(Verifier):
 
 @dataclass(frozen=True)
 class OfflineVerifierConfig:
+    """Weights of the offline verifier and the thresholds at which it refuses.
+
+    The refusal thresholds are measured by ``benchmarks/measure_evidence.py`` on generated
+    apartments (seeds stated there and in the README), from the agreement between what the map
+    observed and the scene's truth; they are not fitted to any instruction."""
+
     name_threshold: float = 0.78  # cosine between target noun and caption name for a non-category match
-    color_reject: float = 0.05  # exp(-ΔE/12) below this (ΔE00 > 36) the colour clearly disagrees
+    #: exp(-ΔE00/12) below this the spoken colour clearly disagrees with every observed colour.
+    color_reject: float = 0.05
+    #: At or above this agreement an object "is" that colour (a negation "not the white one" excludes it).
+    color_match: float = 0.45
+    #: Mapped volumes of one category closer than this ratio are the same size: no size word ranks them.
+    size_ratio: float = 1.3
     w_rank: float = 0.5
     w_color: float = 1.0
     w_size: float = 0.6
     w_shape: float = 0.3
+    w_alternative: float = 0.5  # value lost by an alternative category at weight 0
 
 
 class OfflineVerifier(Verifier):
@@ -109,6 +136,7 @@ class OfflineVerifier(Verifier):
         self._colors: dict[int, list[ColorCluster]] = {}
         self._base_colors: dict[int, list[ColorCluster]] = {}
         self._captioner = ObservationCaptioner()
+        self._name_sims: dict[tuple[str, str], float] = {}
 
     def bind(self, embedder: TextEmbedder, scene: SceneContext) -> None:
         self.embedder = self.embedder or embedder
@@ -133,67 +161,103 @@ class OfflineVerifier(Verifier):
             self._base_colors[obj.id] = self._captioner.base_colors(obj)
         return self._base_colors[obj.id]
 
-    def _name_agreement(self, q: ParsedQuery, obj: MapObject) -> tuple[bool, str]:
-        name = caption_name(obj.caption or obj.label)
-        cat = canonical_label(name)
-        if q.category is not None and (cat == q.category or canonical_label(obj.label) == q.category):
-            return True, f"it is {a(q.category)}"
-        noun = q.category or (" ".join(q.unknown_words) if q.unknown_words else q.target_phrase)
-        if self.embedder is None or not noun:
-            return False, f"it is {a(name)}, not {a(noun)}"
-        v = self.embedder.embed([noun, name])
-        sim = float(v[0] @ v[1])
-        if sim >= self.config.name_threshold:
-            return True, f"'{name}' matches '{noun}' (similarity {sim:.2f})"
-        return False, f"it is {a(name)}, not {a(noun)} (similarity {sim:.2f})"
+    def _name_sim(self, noun: str, name: str) -> float:
+        key = (noun, name)
+        if key not in self._name_sims:
+            assert self.embedder is not None
+            v = self.embedder.embed([noun, name])
+            self._name_sims[key] = float(v[0] @ v[1])
+        return self._name_sims[key]
 
-    def _color(self, q: ParsedQuery, obj: MapObject) -> tuple[float, str]:
-        if not q.colors:
+    def name_agreement(self, q: ParsedQuery, obj: MapObject) -> tuple[bool, float, str]:
+        """(acceptable, category weight, why): the named category (1), an alternative the parser
+        offered (its weight below 1), or a caption name close to an unknown target noun."""
+        name = caption_name(obj.caption or obj.label)
+        cats = {canonical_label(name), canonical_label(obj.label)}
+        if q.category is not None and q.category in cats:
+            return True, 1.0, f"it is {a(q.category)}"
+        alt = max(((q.category_alternatives[c], c) for c in cats if c in q.category_alternatives), default=None)
+        if alt is not None:
+            want = q.category or q.purpose or q.target_phrase
+            return True, alt[0], f"{a(alt[1])} can serve as {a(want)} (weight {alt[0]:.2f})"
+        noun = q.category or (" ".join(q.unknown_words) if q.unknown_words else q.target_phrase)
+        if q.category is None and q.category_alternatives:
+            return False, 0.0, f"it is {a(name)}, not one of {', '.join(sorted(q.category_alternatives))}"
+        if self.embedder is None or not noun:
+            return False, 0.0, f"it is {a(name)}, not {a(noun)}"
+        sim = self._name_sim(noun, name)
+        if sim >= self.config.name_threshold:
+            return True, 1.0, f"'{name}' matches '{noun}' (similarity {sim:.2f})"
+        return False, 0.0, f"it is {a(name)}, not {a(noun)} (similarity {sim:.2f})"
+
+    def color(self, q: ParsedQuery, obj: MapObject, words: list[str] | None = None) -> tuple[float, str]:
+        """Agreement in (0, 1] of the spoken colours (``words`` or the query's) with the object's
+        observed colours (its base's for "the plant in the blue pot"); 0 and "" when none spoken."""
+        words = q.colors if words is None else words
+        if not words:
             return 0.0, ""
-        # "the plant in the blue pot": the colour of the object's base, not of its leaves.
         cols = self.base_colors(obj) if re.search(r"\bpot\b", q.text.lower()) else []
         cols = cols or self.colors(obj)
         if not cols:
             return 0.0, "its colour was not observed"
         vals = []
-        for word in q.colors:
+        for word in words:
             vals.append(max(color_agreement(word, c.lab) * (0.6 + 0.4 * min(1.0, c.fraction / 0.5)) for c in cols))
         agree = float(np.mean(vals))
-        return agree, f"colour {'/'.join(q.colors)} vs observed {cols[0].name} (agreement {agree:.2f})"
+        return agree, f"colour {'/'.join(words)} vs observed {cols[0].name} (agreement {agree:.2f})"
 
-    def _size(self, q: ParsedQuery, obj: MapObject) -> float:
+    def size(self, q: ParsedQuery, obj: MapObject) -> float:
+        """1 when the object is the size the query says among its category, 0 when the opposite,
+        0.5 when the category's mapped volumes are too close to tell (``size_ratio``)."""
         if q.size_word is None or self.scene is None or obj.id not in self.scene.index:
             return 0.0
-        rank, count = self.scene.size_rank(obj)
-        if count < 2:
+        peers = [self.scene.index[o.id] for o in self.scene.same_label(obj)]
+        vols = np.sort(self.scene.volume[peers])
+        if len(vols) < 2 or vols[-1] < self.config.size_ratio * vols[0]:
             return 0.5
-        frac = rank / (count - 1)  # 0 = largest
-        return 1.0 - frac if q.size_word == "large" else frac
+        v = float(self.scene.volume[self.scene.index[obj.id]])
+        frac = float(np.log(v / vols[0]) / np.log(vols[-1] / vols[0]))  # 0 smallest .. 1 largest
+        return frac if q.size_word == "large" else 1.0 - frac
+
+    def assess(self, query: ParsedQuery, c: Candidate, position: float = 0.0) -> Assessment:
+        """Judge one candidate; ``position`` in [0, 1) is its place in the batch (0 = first)."""
+        cfg = self.config
+        ok, weight, why = self.name_agreement(query, c.obj)
+        terms: dict[str, float] = {"similarity": round(c.score, 3)}
+        if not ok:
+            return Assessment(False, 0.0, terms, why)
+        if weight < 1.0:
+            terms["category"] = round(weight, 3)
+        col, cwhy = self.color(query, c.obj)
+        if query.colors:
+            terms["colour"] = round(col, 3)
+            if col < cfg.color_reject:
+                return Assessment(False, 0.0, terms, f"{why} but {cwhy}, below {cfg.color_reject:.2f}")
+        size = self.size(query, c.obj)
+        if query.size_word:
+            terms["size"] = round(size, 3)
+        shape = 0.0
+        if query.shapes and c.obj.caption:
+            shape = float(np.mean([s.lower() in c.obj.caption.lower() for s in query.shapes]))
+            terms["shape"] = round(shape, 3)
+        val = (cfg.w_rank * (1.0 - position) + cfg.w_color * col + cfg.w_size * size + cfg.w_shape * shape
+               - cfg.w_alternative * (1.0 - weight))
+        return Assessment(True, float(val), terms, "; ".join(x for x in (why, cwhy) if x))
 
     def verify(self, query: ParsedQuery, batch: list[Candidate]) -> Verdict:
-        cfg = self.config
-        best: tuple[float, int, str] | None = None
+        best: tuple[int, float, int, str] | None = None
         rejects: list[str] = []
         for i, c in enumerate(batch):
-            ok, why = self._name_agreement(query, c.obj)
-            if not ok:
-                rejects.append(why)
+            v = self.assess(query, c, i / max(len(batch), 1))
+            if not v.ok:
+                rejects.append(v.reason)
                 continue
-            col, cwhy = self._color(query, c.obj)
-            if query.colors and col < cfg.color_reject:
-                rejects.append(f"{why} but {cwhy}")
-                continue
-            shape = 0.0
-            if query.shapes and c.obj.caption:
-                shape = float(np.mean([s.lower() in c.obj.caption.lower() for s in query.shapes]))
-            val = (cfg.w_rank * (1.0 - i / max(len(batch), 1)) + cfg.w_color * col
-                   + cfg.w_size * self._size(query, c.obj) + cfg.w_shape * shape)
-            reason = "; ".join(x for x in (why, cwhy) if x)
-            if best is None or val > best[0]:
-                best = (val, i, reason)
+            # The lowest predicate group first; within it the highest value.
+            if best is None or (c.group, -v.value) < (best[0], -best[1]):
+                best = (c.group, v.value, i, v.reason)
         if best is None:
             return Verdict(None, rejects[0] if rejects else "no candidate")
-        return Verdict(best[1], best[2])
+        return Verdict(best[2], best[3])
 
 
 class VLMVerifier(Verifier):

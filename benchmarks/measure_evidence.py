@@ -1,0 +1,114 @@
+"""Measure the offline verifier's refusal thresholds on generated apartments.
+
+Each threshold says when an observation disagrees with a spoken attribute. It is measured here,
+from how the map's observations of every instance compare with that instance's truth (the
+manifest: colour name, room, model size), never from instructions:
+
+* colour: the agreement (``OfflineVerifier.color``) of an object's observed colours with its true
+  colour word, against the agreement with colour words a person would not use for it (CIEDE2000
+  to the true word above ``--far``). ``color_reject`` keeps all but ``--miss`` of the true words;
+  ``color_match`` (negation: "not the white one") is reached by no more than ``--miss`` of the
+  wrong words.
+* size: mapped volume ratio of two objects of one truth model and size (should be 1); the ratio
+  below which size words cannot rank two instances is its 95th percentile.
+* room: the inferred room against the room that holds the object's centre (inferred, unknown,
+  wrong), which bounds how often a room refusal ("the X in the kitchen") may be wrong.
+
+    .venv/bin/python benchmarks/measure_evidence.py --seeds 1 2 3 --work /tmp/capnav-eval
+
+Maps are built and cached exactly as ``benchmarks/eval_retrieval.py`` builds them (same work folder).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from capnav.language import SceneContext, create_embedder
+from capnav.language.colors import LEX_LAB, NAMES, canonical_color, ciede2000
+from capnav.language.context import label_of
+from capnav.retrieval.query import ParsedQuery
+from capnav.retrieval.verifier import OfflineVerifier
+from eval_retrieval import build, instance_of
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
+    ap.add_argument("--work", type=Path, default=Path("/tmp/capnav-eval"))
+    ap.add_argument("--far", type=float, default=20.0, help="ΔE00 (kL=2) between words that name other colours")
+    ap.add_argument("--miss", type=float, default=0.02, help="share of true (wrong) words a threshold may misjudge")
+    args = ap.parse_args()
+    args.work.mkdir(parents=True, exist_ok=True)
+    true_agree: list[float] = []
+    wrong_agree: list[float] = []
+    ratios: list[float] = []
+    rooms: Counter[str] = Counter()
+    room_rows = []
+    for seed in args.seeds:
+        cmap, manifest = build(seed, args.work)
+        scene = SceneContext(cmap.objects, cmap.occupancy)
+        judge = OfflineVerifier(create_embedder("minilm"), scene)
+        judge.use_attributes(cmap.caches.get("attributes", {}))
+        room_name = {r.id: r.name for r in manifest.rooms}
+        inst = {o.id: instance_of(o, manifest) for o in cmap.objects}
+        for o in cmap.objects:
+            if inst[o.id] is None:
+                continue
+            truth = manifest.object(inst[o.id])
+            word = canonical_color(truth.color_name)
+            if word is not None:
+                text = "the plant in the pot" if truth.category == "plant" else "the object"
+                true_agree.append(judge.color(ParsedQuery(text=text, colors=[word]), o)[0])
+                d = ciede2000(LEX_LAB[NAMES.index(word)][None], LEX_LAB, kL=2.0)
+                for w in (NAMES[k] for k in np.flatnonzero(d > args.far)):
+                    wrong_agree.append(judge.color(ParsedQuery(text=text, colors=[w]), o)[0])
+            said = scene.room_of(o)
+            real = room_name[truth.room]
+            verdict = "unknown" if said is None else ("right" if said == real else "wrong")
+            rooms[verdict] += 1
+            if verdict == "wrong":
+                room_rows.append(f"s{seed} object {o.id} {label_of(o)}: inferred {said}, truth {real}")
+        by_model: dict[tuple[str, tuple[float, ...]], list[float]] = {}
+        for o in cmap.objects:
+            if inst[o.id] is not None:
+                t = manifest.object(inst[o.id])
+                key = (t.model, tuple(round(v, 3) for v in t.size))
+                by_model.setdefault(key, []).append(float(scene.volume[scene.index[o.id]]))
+        for vols in by_model.values():
+            for i in range(len(vols)):
+                for j in range(i + 1, len(vols)):
+                    ratios.append(max(vols[i], vols[j]) / max(min(vols[i], vols[j]), 1e-9))
+    ta, wa = np.array(true_agree), np.array(wrong_agree)
+    reject = float(np.quantile(ta, args.miss))
+    match = float(np.quantile(wa, 1.0 - args.miss))
+    print(f"\nseeds {args.seeds}: {len(ta)} objects with a true colour word, {len(wa)} (object, wrong word) pairs")
+    print("| measure | value |")
+    print("|---|---:|")
+    print(f"| colour agreement, true word: p1 / p2 / p5 / median | {np.quantile(ta, 0.01):.3f} / "
+          f"{np.quantile(ta, 0.02):.3f} / {np.quantile(ta, 0.05):.3f} / {np.median(ta):.3f} |")
+    print(f"| colour agreement, wrong word: median / p95 / p98 / max | {np.median(wa):.3f} / "
+          f"{np.quantile(wa, 0.95):.3f} / {np.quantile(wa, 0.98):.3f} / {wa.max():.3f} |")
+    print(f"| color_reject (true words kept: {1 - args.miss:.0%}) | {reject:.3f} |")
+    print(f"|   wrong words refused at color_reject | {np.mean(wa < reject):.1%} |")
+    print(f"| color_match (wrong words reaching it: {args.miss:.0%}) | {match:.3f} |")
+    print(f"|   true words reaching color_match | {np.mean(ta >= match):.1%} |")
+    if ratios:
+        r = np.array(ratios)
+        print(f"| volume ratio of same-size instances: median / p95 / max ({len(r)} pairs) | "
+              f"{np.median(r):.2f} / {np.quantile(r, 0.95):.2f} / {r.max():.2f} |")
+    total = sum(rooms.values())
+    print(f"| rooms inferred right / unknown / wrong ({total} objects) | {rooms['right'] / total:.1%} / "
+          f"{rooms['unknown'] / total:.1%} / {rooms['wrong'] / total:.1%} |")
+    for row in room_rows:
+        print(f"  wrong room: {row}")
+
+
+if __name__ == "__main__":
+    main()
