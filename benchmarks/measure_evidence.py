@@ -34,7 +34,7 @@ from capnav.language import SceneContext, create_embedder
 from capnav.language.colors import LEX_LAB, NAMES, canonical_color, ciede2000
 from capnav.language.context import label_of
 from capnav.retrieval.query import ParsedQuery
-from capnav.retrieval.verifier import OfflineVerifier
+from capnav.retrieval.verifier import OfflineVerifier, OfflineVerifierConfig
 from eval_retrieval import build, instance_of
 
 
@@ -44,6 +44,8 @@ def main() -> None:
     ap.add_argument("--work", type=Path, default=Path("/tmp/capnav-eval"))
     ap.add_argument("--far", type=float, default=20.0, help="ΔE00 (kL=2) between words that name other colours")
     ap.add_argument("--miss", type=float, default=0.02, help="share of true (wrong) words a threshold may misjudge")
+    ap.add_argument("--color-floor", type=float, default=None,
+                    help="weight of a small colour cluster (OfflineVerifierConfig.color_floor) to measure with")
     args = ap.parse_args()
     args.work.mkdir(parents=True, exist_ok=True)
     true_agree: list[float] = []
@@ -54,7 +56,8 @@ def main() -> None:
     for seed in args.seeds:
         cmap, manifest = build(seed, args.work)
         scene = SceneContext(cmap.objects, cmap.occupancy)
-        judge = OfflineVerifier(create_embedder("minilm"), scene)
+        cfg = OfflineVerifierConfig() if args.color_floor is None else OfflineVerifierConfig(color_floor=args.color_floor)
+        judge = OfflineVerifier(create_embedder("minilm"), scene, cfg)
         judge.use_attributes(cmap.caches.get("attributes", {}))
         room_name = {r.id: r.name for r in manifest.rooms}
         inst = {o.id: instance_of(o, manifest) for o in cmap.objects}

@@ -105,9 +105,10 @@ def test_the_x_in_a_room_where_no_x_stands_is_not_found(retriever):
 
 
 def test_negation_excludes_what_it_names(retriever):
-    res = ask(retriever, "the washing machine but not the white one", negations=["white"])
+    res = ask(retriever, "the washing machine but not the white one", negations=["white"], colors=[])
     assert res.found and res.chosen.id == 6 and "excluded" in res.reason
-    res = ask(retriever, "a washing machine that is not white or dark grey", negations=["white", "dark grey"])
+    res = ask(retriever, "a washing machine that is not white or dark grey", negations=["white", "dark grey"],
+              colors=[])
     assert not res.found
 
 
@@ -146,3 +147,13 @@ def test_runners_up_are_in_decision_order_with_their_terms(retriever):
     accepted = [r["score"] for r in runners if not r["why"].startswith(("rejected", "not verified"))]
     assert accepted == sorted(accepted, reverse=True)
     assert "highest verification score" in res.reason or "satisfies" in res.reason
+
+
+def test_the_room_with_a_landmark_is_the_landmarks_region(retriever):
+    res = ask(retriever, "the lamp in the room with the fridge", relation="in the room with",
+              anchor_category="refrigerator", anchor_phrase="fridge")
+    assert not res.found  # both lamps stand in the living room
+    assert "no lamp stands in the room with the fridge" in res.reason
+    res = ask(retriever, "the armchair in the room with the bookshelf", relation="in the room with",
+              anchor_category="bookshelf", anchor_phrase="bookshelf")
+    assert res.found and res.chosen.label == "armchair"

@@ -49,7 +49,8 @@ class ContextConfig:
     los_range: float = 3.0  # m of box gap up to which walls between objects are checked
     door_width: float = 1.0  # m: interior doorways are narrower, so eroding by half of it parts the rooms
     min_room_m2: float = 1.0  # m² of eroded core below which a region is not a room of its own
-    region_strong: float = 0.9  # cue score above which a region clearly is that room type (two: open plan)
+    region_strong: float = 0.9  # noisy-or cue score above which a region clearly is that room type
+    open_plan_ratio: float = 0.75  # second room type's cue weight over the first's for an open plan
 
 
 def canonical_label(label: str) -> str:
@@ -127,9 +128,9 @@ class SceneContext:
 
     def _regions(self) -> None:
         """Rooms from the free space: each object belongs to the region it is reached from, and a
-        region's type is what its cue objects say together (noisy-or of their weights per type).
-        A region whose cues name two types strongly (an open plan) keeps the per-object
-        distance-based scores."""
+        region's type is what its cue objects say together (the most cue weight; its strength the
+        noisy-or of the weights). A region whose cues name two types about equally (an open plan)
+        keeps the per-object distance-based scores."""
         from capnav.language.rooms import object_region, segment_rooms, walkable_domain
 
         assert self.occupancy is not None
@@ -142,16 +143,20 @@ class SceneContext:
                                dtype=np.int64)
         for k in sorted({int(r) for r in self.region} - {-1}):
             members = np.flatnonzero(self.region == k)
-            scores = {}
+            scores, mass = {}, {}
             for room, cues in ROOM_CUES.items():
-                miss = np.prod([1.0 - cues[self.labels[i]] for i in members if self.labels[i] in cues])
-                scores[room] = float(1.0 - miss)
-            strong = [r for r, v in scores.items() if v >= self.config.region_strong]
-            best, val = max(scores.items(), key=lambda kv: kv[1])
-            if len(strong) > 1 and self.config.region_strong <= 1.0:
-                self.region_rooms[k] = (None, scores)  # an open plan: decide per object
+                w = [cues[self.labels[i]] for i in members if self.labels[i] in cues]
+                scores[room] = float(1.0 - np.prod([1.0 - x for x in w]))
+                mass[room] = float(sum(w))
+            ranked = sorted(mass.items(), key=lambda kv: -kv[1])
+            best = ranked[0][0]
+            # Two room types with about as much cue weight (a kitchen open to the living room):
+            # an open plan, decided per object by its nearest cues. A desk in a bedroom is not one.
+            if len(ranked) > 1 and ranked[1][1] >= self.config.open_plan_ratio * ranked[0][1] \
+                    and scores[ranked[1][0]] >= self.config.region_strong:
+                self.region_rooms[k] = (None, scores)
             else:
-                self.region_rooms[k] = (best if val >= self.config.room_min_score else None, scores)
+                self.region_rooms[k] = (best if scores[best] >= self.config.room_min_score else None, scores)
         for i, reg in enumerate(self.region):
             typed = self.region_rooms.get(int(reg))
             if typed is not None and typed[0] is not None:

@@ -33,6 +33,8 @@ from capnav.retrieval.verifier import AcceptFirst, Assessment, Candidate, Offlin
 
 _VOCAB = set(NAMES)
 _ROOMS = list(ROOM_CUES)
+#: The relation of "the bed in the room with the pink dresser" (ParsedQuery.relation).
+ROOM_WITH = "in the room with"
 _ORDINALS = {2: "second", 3: "third", 4: "fourth", 5: "fifth"}
 
 
@@ -234,7 +236,15 @@ class Retriever:
                 same = pool[:, None] == anchors[None, :]
                 gap = np.where(same, np.inf, gap).min(axis=1)
                 values["gap to landmark (m)"] = gap
-                if q.proximity_to_anchor and q.proximity is not None:
+                regions = {int(self.scene.region[k]) for k in anchors} - {-1}
+                if q.relation == ROOM_WITH and regions:
+                    # "the bed in the room with the pink dresser": the landmark's room region.
+                    same_room = np.array([int(self.scene.region[i]) in regions for i in pool], dtype=np.float64)
+                    group_keys.append(-same_room)
+                    predicate = f"{ROOM_WITH} the {q.anchor_category}"
+                    if not same_room.any() and refusal is None:
+                        refusal = f"no {q.category or q.target_phrase} stands in the room with the {q.anchor_phrase}"
+                elif q.proximity_to_anchor and q.proximity is not None:
                     # "the chair closest to the table": distance to the landmark, exactly.
                     centre = np.linalg.norm(self.scene.xy[pool][:, None] - self.scene.xy[anchors][None], axis=2)
                     centre = np.where(same, np.inf, centre).min(axis=1)
