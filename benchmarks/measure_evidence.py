@@ -56,7 +56,7 @@ def main() -> None:
     for seed in args.seeds:
         cmap, manifest = build(seed, args.work)
         scene = SceneContext(cmap.objects, cmap.occupancy)
-        cfg = OfflineVerifierConfig() if args.color_floor is None else OfflineVerifierConfig(color_floor=args.color_floor)
+        cfg = OfflineVerifierConfig(**({} if args.color_floor is None else {"color_floor": args.color_floor}))
         judge = OfflineVerifier(create_embedder("minilm"), scene, cfg)
         judge.use_attributes(cmap.caches.get("attributes", {}))
         room_name = {r.id: r.name for r in manifest.rooms}
