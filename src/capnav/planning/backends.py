@@ -1,4 +1,4 @@
-"""Grid search backends by name: our numba A* and, for comparison, two reference libraries.
+"""Grid search backends by name: our numba A* and, for comparison, three reference libraries.
 
 All take the same float64 weight grid (``inf`` = blocked, >= 1 elsewhere) and return the cell path
 and its cost under one rule (``search.edge cost = step * mean weight``), so they are comparable.
@@ -75,6 +75,28 @@ def _pyastar_factory() -> GridSearch:
         if path is None:
             return np.empty((0, 2), np.intp), float("inf")
         cells = np.asarray(path, dtype=np.intp)
+        return cells, path_cost(weights, cells)
+
+    return search
+
+
+@BACKENDS.register("tcod")
+def _tcod_factory() -> GridSearch:
+    """libtcod's C A* (python-tcod, ``bench`` extra) with diagonal steps costing sqrt(2): the
+    octile metric, so on uniform grids its paths are optimal for ours. It prices a step by the
+    weight of the cell entered (not the mean of both cells), so on graded grids its path is
+    optimal for that rule only; the cost returned here is its path under ours."""
+    try:
+        import tcod.path
+    except ImportError:
+        raise InputError("backend 'tcod' needs python-tcod: pip install 'capnav[bench]'") from None
+
+    def search(weights: NDArray[np.float64], start: Cell, goal: Cell) -> tuple[NDArray[np.intp], float]:
+        cost = np.where(np.isfinite(weights), weights, 0.0).astype(np.float32)  # 0 = blocked for tcod
+        steps = tcod.path.AStar(cost, diagonal=float(np.sqrt(2.0))).get_path(start[0], start[1], goal[0], goal[1])
+        if not steps and tuple(start) != tuple(goal):
+            return np.empty((0, 2), np.intp), float("inf")
+        cells = np.asarray([tuple(start), *steps], dtype=np.intp)
         return cells, path_cost(weights, cells)
 
     return search

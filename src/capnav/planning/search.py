@@ -84,33 +84,52 @@ def _octile(r: int, c: int, gr: int, gc: int) -> float:
 
 
 @njit(cache=True)
+def _min_finite(flat: NDArray[np.float64]) -> float:
+    m = np.inf
+    for x in flat:
+        if x < m:
+            m = x
+    return m if m < np.inf else 1.0
+
+
+#: ``state`` of a cell during a search: never reached (its g and parent are garbage), in the
+#: open heap, expanded. One byte per cell, so a query clears n bytes instead of 17n.
+UNSEEN, OPEN, CLOSED = 0, 1, 2
+
+
+@njit(cache=True)
 def _search(w: NDArray[np.float64], start: int, goal: int, hscale: float
-            ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    """Best-first search from ``start``; stops at ``goal`` (or exhausts the grid when goal < 0)."""
+            ) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.uint8]]:
+    """Best-first search from ``start``; stops at ``goal`` (or exhausts the grid when goal < 0).
+
+    ``g`` and ``parent`` are left uninitialised and read only where ``state`` says a cell was
+    reached (the grid is touched only where the search goes, as in pyastar2d)."""
     rows, cols = w.shape
     n = rows * cols
     flat = w.ravel()
-    g = np.full(n, np.inf)
-    parent = np.full(n, -1, np.int64)
-    closed = np.zeros(n, np.bool_)
-    hf = np.empty(1024, np.float64)
-    hi = np.empty(1024, np.int64)
+    g = np.empty(n, np.float64)
+    parent = np.empty(n, np.int64)
+    state = np.zeros(n, np.uint8)
+    hf = np.empty(4096, np.float64)
+    hi = np.empty(4096, np.int64)
     hscale = hscale * (1.0 + TIE_BREAK)
     gr = goal // cols if goal >= 0 else 0
     gc = goal % cols if goal >= 0 else 0
     g[start] = 0.0
+    parent[start] = -1
+    state[start] = OPEN
     _push(hf, hi, 0, 0.0, start)
     size = 1
     while size > 0:
         u = _pop(hf, hi, size)
         size -= 1
-        if closed[u]:
+        if state[u] == CLOSED:
             continue
-        closed[u] = True
+        state[u] = CLOSED
         if u == goal:
             break
         ur = u // cols
-        uc = u % cols
+        uc = u - ur * cols
         wu = flat[u]
         gu = g[u]
         for k in range(8):
@@ -119,19 +138,30 @@ def _search(w: NDArray[np.float64], start: int, goal: int, hscale: float
             if vr < 0 or vr >= rows or vc < 0 or vc >= cols:
                 continue
             v = vr * cols + vc
+            sv = state[v]
             wv = flat[v]
-            if closed[v] or not wv < np.inf:
+            if sv == CLOSED or not wv < np.inf:
                 continue
             ng = gu + _STEP[k] * 0.5 * (wu + wv)
-            if ng < g[v]:
+            if ng < (g[v] if sv == OPEN else np.inf):
                 g[v] = ng
                 parent[v] = u
+                state[v] = OPEN
                 f = ng + hscale * _octile(vr, vc, gr, gc) if goal >= 0 else ng
                 if size == hf.shape[0]:
                     hf, hi = _grow(hf, hi)
                 _push(hf, hi, size, f, v)
                 size += 1
-    return g, parent
+    return g, parent, state
+
+
+@njit(cache=True)
+def _field(g: NDArray[np.float64], parent: NDArray[np.int64], state: NDArray[np.uint8]) -> None:
+    """Unreached cells: cost inf, parent -1 (the whole-grid answer of ``cost_field``)."""
+    for i in range(g.shape[0]):
+        if state[i] == UNSEEN:
+            g[i] = np.inf
+            parent[i] = -1
 
 
 def astar(weights: NDArray[np.float64], start: tuple[int, int], goal: tuple[int, int]
@@ -141,10 +171,8 @@ def astar(weights: NDArray[np.float64], start: tuple[int, int], goal: tuple[int,
     cols = w.shape[1]
     s = int(start[0]) * cols + int(start[1])
     t = int(goal[0]) * cols + int(goal[1])
-    finite = w[np.isfinite(w)]
-    hscale = float(finite.min()) if finite.size else 1.0
-    g, parent = _search(w, s, t, hscale)
-    if not np.isfinite(g[t]):
+    g, parent, state = _search(w, s, t, _min_finite(w.ravel()))
+    if state[t] == UNSEEN or not np.isfinite(g[t]):
         return np.empty((0, 2), np.intp), float("inf")
     return _backtrack(parent, t, cols), float(g[t])
 
@@ -152,7 +180,8 @@ def astar(weights: NDArray[np.float64], start: tuple[int, int], goal: tuple[int,
 def cost_field(weights: NDArray[np.float64], start: tuple[int, int]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """Dijkstra from ``start`` over the whole grid: cost (rows, cols) and flat parent indices."""
     w = np.ascontiguousarray(weights, dtype=np.float64)
-    g, parent = _search(w, int(start[0]) * w.shape[1] + int(start[1]), -1, 0.0)
+    g, parent, state = _search(w, int(start[0]) * w.shape[1] + int(start[1]), -1, 0.0)
+    _field(g, parent, state)
     return g.reshape(w.shape), parent
 
 
