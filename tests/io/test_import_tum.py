@@ -38,10 +38,10 @@ def _line(t: float, T: np.ndarray) -> str:
 
 
 def write_tum(root: Path, frames: list[Frame], depth_lag: dict[int, float] | None = None,
-              gt_end: int | None = None) -> list[float]:
-    """Write ``frames`` as a TUM sequence; colour stamps are returned. Ground truth comes as two poses
-    10 ms either side of each frame, turned +-3 degrees and moved +-2 cm, so only interpolation
-    recovers the pose at the frame's stamp."""
+              gt_end: int | None = None, world: np.ndarray = W) -> list[float]:
+    """Write ``frames`` as a TUM sequence in the recording world ``world`` (CapNav's world in it);
+    colour stamps are returned. Ground truth comes as two poses 10 ms either side of each frame,
+    turned +-3 degrees and moved +-2 cm, so only interpolation recovers the pose at the frame's stamp."""
     (root / "rgb").mkdir(parents=True)
     (root / "depth").mkdir()
     rgb_lines, dep_lines, gt_lines = ["# color images", "# timestamp filename"], ["# depth maps"], ["# ground truth"]
@@ -57,7 +57,7 @@ def write_tum(root: Path, frames: list[Frame], depth_lag: dict[int, float] | Non
         dep_lines.append(f"{td:.6f} depth/{td:.6f}.png")
         if gt_end is not None and i >= gt_end:
             continue
-        T = W @ f.T_wc
+        T = world @ f.T_wc
         for s in (-1.0, 1.0):
             D = np.eye(4)
             D[:3, :3] = Rotation.from_rotvec(s * np.radians(3.0) * np.array([0.3, 0.9, 0.3])).as_matrix()
