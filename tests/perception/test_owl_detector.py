@@ -206,8 +206,8 @@ def test_slanted_object_is_grown_and_a_small_occluder_ignored() -> None:
     box = (8.0, 8.0, 72.0, 52.0)
     full = depth_box_mask(depth, box)
     assert full[10:50, 10:70].all() and full.sum() == 40 * 60  # all of it, none of the wall
-    front = depth_box_mask(depth, box, extent=0.0)
-    assert 0 < front.sum() < 40 * 20  # without growing: only its front band
+    front = depth_box_mask(depth, box, extent=0.0, method="mode")
+    assert 0 < front.sum() < 40 * 20  # the mode method without growing: only its front band
     assert grow_smooth(depth, np.ones(depth.shape, bool), front).sum() == 40 * 60  # the jump to the wall stops it
     far = np.full((60, 80), 3.0, dtype=np.float32)
     far[10:50, 10:70] = 2.0  # the detected object
@@ -217,6 +217,40 @@ def test_slanted_object_is_grown_and_a_small_occluder_ignored() -> None:
     assert (depth_box_mask(far, (8.0, 8.0, 72.0, 52.0)) == (far == 2.0)).all()
     far[25:50, 10:45] = 1.0  # a big occluder is the known failure: the nearest strong surface is taken
     assert depth_modes(far[8:52, 8:72])[0] < 1.5
+
+
+def _open_chair_before_wall() -> tuple[np.ndarray, np.ndarray]:
+    """An open-frame chair 1.4-1.75 m away (two legs, a seat, the frame of an empty back) 0.4 m in
+    front of a wall, floor rows at the bottom: the wall fills most of the chair's box."""
+    depth = np.full((80, 80), 2.1, dtype=np.float32)
+    rows = np.arange(80, dtype=np.float32)[:, None]
+    depth[68:, :] = np.broadcast_to(1.2 + 0.012 * (79 - rows[68:]), (12, 80))  # floor, nearer than the wall
+    chair = np.zeros(depth.shape, dtype=bool)
+    chair[10:12, 25:55] = True  # top rail of the back
+    chair[10:45, 25:27] = chair[10:45, 53:55] = True  # back posts
+    chair[42:45, 25:55] = True  # seat edge
+    chair[42:70, 27:29] = chair[42:70, 51:53] = True  # legs down to the floor
+    cols = np.broadcast_to(np.arange(80, dtype=np.float32)[None, :], depth.shape)
+    depth[chair] = (1.4 + 0.012 * (cols - 25))[chair]  # the chair is seen from the side
+    return depth, chair
+
+
+def test_open_chair_mask_keeps_the_chair_not_the_wall_behind() -> None:
+    depth, chair = _open_chair_before_wall()
+    box = (23.0, 8.0, 57.0, 70.0)
+    wall = depth == 2.1
+    assert wall[8:70, 23:57].sum() > 2 * chair.sum()  # most of the box is wall
+    floor = np.zeros(depth.shape, dtype=bool)
+    floor[68:] = ~chair[68:]  # what floor_pixels finds when the pose is known
+    m = depth_box_mask(depth, box, exclude=floor)
+    assert not (m & wall).any()
+    assert (m & chair).sum() >= 0.95 * chair.sum() and not (m & ~chair).any()
+    nofloor = depth_box_mask(depth, box)  # without the pose: still none of the wall
+    assert not (nofloor & wall).any() and (nofloor & chair).sum() >= 0.95 * chair.sum()
+    old = depth_box_mask(depth, box, exclude=floor, method="mode")  # a band around the nearest mode: part of it
+    assert (old & chair).sum() < 0.8 * chair.sum()
+    with pytest.raises(InputError, match="method"):
+        depth_box_mask(depth, box, method="sam")
 
 
 def test_floor_pixels_follow_the_pose() -> None:

@@ -7,7 +7,8 @@ Each map object is matched to the ground-truth instance whose oriented box (grow
 ``min_frames`` frames (``min_pixels`` visible pixels each) that got an object / such instances;
 duplicate rate = objects beyond the first on the same instance / objects; category accuracy =
 matched objects whose label is the instance's category / matched objects; centroid error = 3D
-distance from the best (most hits) object's position to the instance's box centre; occupancy IoU
+distance from the best (most hits) object's position to the instance's box centre; size error
+(``size_error``) = the larger of its caption width and height errors; occupancy IoU
 = IoU of OCCUPIED cells of the map and of the truth (sampled at the map's cell centres) over the
 truth's apartment area.
 """
@@ -26,6 +27,7 @@ from capnav.core.errors import CapNavError
 from capnav.core.frame import Frame
 from capnav.core.grid import OCCUPIED, UNKNOWN, OccupancyGrid
 from capnav.mapping.cmap import CapNavMap
+from capnav.mapping.objects import MapObject
 from capnav.sim.manifest import ObjectInstance, SceneManifest
 
 
@@ -89,6 +91,27 @@ def inside_box(points: NDArray[np.floating], inst: ObjectInstance, margin: float
     return np.all(np.abs(local) <= np.asarray(inst.size) / 2 + margin, axis=1)
 
 
+def caption_size(extent: NDArray[np.floating]) -> tuple[float, float]:
+    """(width, height) as captions state them: the larger horizontal side of the world-aligned
+    extent (x, y, z) and its height."""
+    e = np.asarray(extent, dtype=np.float64)
+    return float(max(e[0], e[1])), float(e[2])
+
+
+def true_extent(inst: ObjectInstance) -> NDArray[np.float64]:
+    """World-aligned (x, y, z) extent of an instance's oriented box."""
+    fp = np.asarray(inst.footprint, dtype=np.float64)
+    return np.array([np.ptp(fp[:, 0]), np.ptp(fp[:, 1]), float(inst.size[2])])
+
+
+def size_error(obj: MapObject, inst: ObjectInstance) -> float:
+    """How far the caption's size of ``obj`` is from the truth: the larger of the width and the
+    height errors (m), both measured as ``caption_size`` states them."""
+    w, h = caption_size(obj.extent_max - obj.extent_min)
+    tw, th = caption_size(true_extent(inst))
+    return max(abs(w - tw), abs(h - th))
+
+
 def occupancy_iou(pred: OccupancyGrid, truth: OccupancyGrid) -> float | None:
     """IoU of OCCUPIED cells over the map cells that fall on known truth cells."""
     rr, cc = np.mgrid[0:pred.spec.rows, 0:pred.spec.cols]
@@ -136,7 +159,7 @@ def evaluate_map(cmap: CapNavMap, manifest: SceneManifest, seen: dict[int, int] 
         if objs:
             best = max(objs, key=lambda o: o.hits)
             err = float(np.linalg.norm(best.position - np.asarray(g.center)))
-            rec.update(label=best.label, centroid_error=round(err, 4))
+            rec.update(label=best.label, centroid_error=round(err, 4), size_error=round(size_error(best, g), 4))
             errors.append(err)
         per.append(rec)
     n = len(cmap.objects)

@@ -1,23 +1,27 @@
-"""Instance masks from detector boxes, for detectors that predict boxes only (OWL-ViT, OWLv2).
+"""Instance masks from detector boxes, for detectors that predict boxes only (COCO detectors, OWL-ViT).
 
 The mapper lifts a detection's mask into 3D, so a filled box would smear the wall or floor
-behind an object into its instance. ``depth_box_mask`` keeps the object instead. Inside the box
-it finds the strong depth modes (``band``-wide depth slabs holding at least ``min_mode_frac`` of
-the strongest slab's pixels, so a few stray near pixels do not count), takes the pixels within
+behind an object into its instance, and the object's size (a caption's "1.4 m wide") with it.
+``depth_box_mask`` keeps the object's own pixels. The default ``method="surfaces"``
+(``surface_mask``) cuts the box and a ring around it into smooth depth surfaces and drops the
+background ones: those that run on out of the box on two sides (walls, a far room) and those
+seen only through the object (the wall between chair slats, under a table); of the rest, the
+group of touching surfaces that fills the box and is least hidden is the object. The floor
+touches every object's base smoothly, so it is excluded first when the camera pose is known
+(``floor_pixels``). ``method="mode"`` (the method before issue 11, and the fallback when no
+surface qualifies) finds the strong depth modes inside the box (``band``-wide depth slabs
+holding at least ``min_mode_frac`` of the strongest slab's pixels), takes the pixels within
 ``band / 2`` of the nearest one and their largest 8-connected component, and grows that along
-smooth depth (no jump between neighbours), up to ``extent`` metres behind the mode, because a
-sofa or a shelf seen at a slant spans more depth than a band. Objects stand in front of what
-their box also catches (walls, far furniture), so the nearest strong mode is usually the
-object. The floor touches every object's base smoothly, so it is excluded first when the
-camera pose is known (``floor_pixels``). Invalid depth (0, non-finite) is never part of a depth
-mask: it would not reach a voxel anyway. ``filled_box_mask`` is the plain box.
+smooth depth up to ``extent`` metres behind the mode: a thin or see-through object (an open
+chair frame) is too weak a mode next to the wall behind it, and the wall is taken instead.
+Invalid depth (0, non-finite) is never part of a depth mask: it would not reach a voxel anyway.
+``filled_box_mask`` is the plain box.
 
-Measured on boxes equal to the true instance boxes (objects >= 200 px, 160x120), median IoU
-with the true mask: 0.98 on the tests' ray-cast box scenes (36 frames; 0.78 with the band
-alone), 0.80 on a ``capnav sim`` apartment (seed 0, 12 frames, 39 objects; 0.53 with the band
-alone, no growing and no floor removal). The known failure is an occluder in front of the
-object filling a large part of its box: its surface is the nearest strong mode and is taken
-instead. ``mask="sam"`` of the owl detector is the better choice when a SAM folder is at hand.
+Measured by ``benchmarks/bench_box_masks.py`` (true boxes grown by 5%, Sweet Home 3D apartments,
+640x480; numbers in the README): the median IoU with the true instance mask and the share of
+mask pixels off the instance, per category, for both methods. The known failure of both is an
+occluder in front of the object filling a large part of its box (a table behind its chairs).
+``mask="sam"`` of the owl detector is the better choice when a SAM folder is at hand.
 """
 
 from __future__ import annotations
@@ -28,12 +32,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 from capnav.core.errors import InputError
 
 Box = tuple[float, float, float, float]
 
 _EIGHT = np.ones((3, 3), dtype=bool)
+MASK_METHODS = ("surfaces", "mode")
 
 
 def box_pixels(box: Box, shape: tuple[int, int]) -> tuple[int, int, int, int]:
@@ -93,15 +100,21 @@ def nearest_depth_mode(depths: NDArray[np.floating], window: float = 0.4, bin_si
 
 def depth_box_mask(depth: NDArray[np.floating], box: Box, band: float = 0.4, bin_size: float = 0.05,
                    min_mode_frac: float = 0.3, min_valid: int = 4, extent: float = 1.5, gap: float = 0.04,
-                   gap_rel: float = 0.02, exclude: NDArray[np.bool_] | None = None) -> NDArray[np.bool_]:
-    """The object in ``box``: the surface at the box's nearest strong depth mode.
+                   gap_rel: float = 0.02, exclude: NDArray[np.bool_] | None = None,
+                   method: str = "surfaces") -> NDArray[np.bool_]:
+    """The object in ``box``.
 
-    The pixels within ``band / 2`` of the mode's median depth, their largest 8-connected
-    component, grown along smooth depth up to ``extent`` metres behind the mode
+    ``method="surfaces"`` (default, ``surface_mask``): the box's smooth surfaces minus the
+    background ones (those that run out of the box on two sides, and those seen only through
+    the object), falling back to the mode method when no surface is left. ``method="mode"``: the
+    pixels within ``band / 2`` of the nearest strong depth mode's median depth, their largest
+    8-connected component, grown along smooth depth up to ``extent`` metres behind the mode
     (``grow_smooth``). ``exclude`` (H, W) marks pixels that belong to no object (the floor,
     ``floor_pixels``). Returns an empty mask when the box holds fewer than ``min_valid`` usable
     depth pixels.
     """
+    if method not in MASK_METHODS:
+        raise InputError(f"unknown depth mask method {method!r}; available: {', '.join(MASK_METHODS)}")
     if band <= 0 or bin_size <= 0:
         raise InputError(f"depth mask band and bin_size must be > 0, got {band} and {bin_size}")
     z = np.asarray(depth)
@@ -118,6 +131,10 @@ def depth_box_mask(depth: NDArray[np.floating], box: Box, band: float = 0.4, bin
         valid &= ~np.asarray(exclude, dtype=bool)[r0:r1, c0:c1]
     if int(valid.sum()) < max(1, min_valid):
         return mask
+    if method == "surfaces":
+        surf = surface_mask(z, (c0, r0, c1, r1), exclude, extent=extent, gap=gap, gap_rel=gap_rel, min_valid=min_valid)
+        if surf is not None:
+            return surf
     crop = np.where(valid, crop, 0.0)
     mode = nearest_depth_mode(crop[valid], band, bin_size, min_mode_frac)
     mask[r0:r1, c0:c1] = _mode_component(crop, valid, mode, 0.5 * band, extent, gap, gap_rel)
@@ -165,15 +182,7 @@ def grow_smooth(z: NDArray[np.floating], allowed: NDArray[np.bool_], seed: NDArr
     z = np.asarray(z, dtype=np.float64)
     ok = np.asarray(allowed, dtype=bool)
     tol = gap + gap_rel * np.abs(z)
-    jump = np.zeros(z.shape, dtype=bool)
-    for axis in (0, 1):
-        a = np.swapaxes(z, 0, axis)
-        t = np.swapaxes(tol, 0, axis)
-        okk = np.swapaxes(ok, 0, axis)
-        step = (np.abs(a[1:] - a[:-1]) > np.maximum(t[1:], t[:-1])) & okk[1:] & okk[:-1]
-        j = np.swapaxes(jump, 0, axis)  # a view: writes land in ``jump``
-        j[1:] |= step
-        j[:-1] |= step
+    jump = depth_jumps(z, ok, gap, gap_rel)
     labels, _ = ndimage.label(ok & ~jump)  # 4-connected: a one-pixel jump line separates regions
     hit = np.unique(labels[seed & (labels > 0)])
     grown = np.isin(labels, hit[hit > 0]) | (seed & ok)
@@ -183,6 +192,182 @@ def grow_smooth(z: NDArray[np.floating], allowed: NDArray[np.bool_], seed: NDArr
         nb_z = _shift(z, dy, dx, 0.0)
         add |= ok & ~grown & nb_in & (np.abs(z - nb_z) <= tol)
     return grown | add
+
+
+def depth_jumps(z: NDArray[np.floating], ok: NDArray[np.bool_], gap: float = 0.04, gap_rel: float = 0.02,
+                far_only: bool = False) -> NDArray[np.bool_]:
+    """Pixels on either side (``far_only``: on the far side) of a neighbour step larger than
+    ``gap + gap_rel * z`` (both valid). Marking the far side only keeps a one-pixel-thin near
+    part (a chair leg, a lamp pole) whole while still cutting it from what lies behind."""
+    z = np.asarray(z, dtype=np.float64)
+    tol = gap + gap_rel * np.abs(z)
+    jump = np.zeros(z.shape, dtype=bool)
+    for axis in (0, 1):
+        a = np.swapaxes(z, 0, axis)
+        t = np.swapaxes(tol, 0, axis)
+        okk = np.swapaxes(ok, 0, axis)
+        step = (np.abs(a[1:] - a[:-1]) > np.maximum(t[1:], t[:-1])) & okk[1:] & okk[:-1]
+        j = np.swapaxes(jump, 0, axis)  # a view: writes land in ``jump``
+        if far_only:
+            j[1:] |= step & (a[1:] > a[:-1])
+            j[:-1] |= step & (a[:-1] > a[1:])
+        else:
+            j[1:] |= step
+            j[:-1] |= step
+    return jump
+
+
+def depth_kinks(z: NDArray[np.floating], ok: NDArray[np.bool_], kink: float = 0.03, kink_rel: float = 0.01
+                ) -> NDArray[np.bool_]:
+    """Pixels where the depth profile bends by more than ``kink + kink_rel * z`` (second difference
+    along a row or column, three valid pixels, both steps smaller than the bend threshold times
+    two: a jump is no bend): the crease where an object meets a wall it stands against shows no
+    depth jump, but a bend."""
+    z = np.asarray(z, dtype=np.float64)
+    tol = kink + kink_rel * np.abs(z)
+    out = np.zeros(z.shape, dtype=bool)
+    for axis in (0, 1):
+        a = np.swapaxes(z, 0, axis)
+        okk = np.swapaxes(ok, 0, axis)
+        o = np.swapaxes(out, 0, axis)
+        t = np.swapaxes(tol, 0, axis)[1:-1]
+        d1, d0 = a[2:] - a[1:-1], a[1:-1] - a[:-2]
+        bend = (np.abs(d1 - d0) > t) & (np.abs(d1) <= 2.0 * t) & (np.abs(d0) <= 2.0 * t)
+        o[1:-1] |= bend & okk[2:] & okk[1:-1] & okk[:-2]
+    return out
+
+
+def _attach(z: NDArray[np.float64], labels: NDArray[np.int64], free: NDArray[np.bool_], tol: NDArray[np.float64]
+            ) -> NDArray[np.int64]:
+    """Give each ``free`` pixel the label of its 8-neighbour of nearest depth (within ``tol``)."""
+    best = np.full(z.shape, np.inf)
+    out = labels.copy()
+    for dy, dx in _SHIFTS:
+        nb_l = _shift(labels, dy, dx, 0)
+        diff = np.abs(z - _shift(z, dy, dx, 0.0))
+        take = free & (nb_l > 0) & (diff <= tol) & (diff < best)
+        out[take] = nb_l[take]
+        best[take] = diff[take]
+    return out
+
+
+def _group(main: int, zmean: NDArray[np.float64], hidden: NDArray[np.float64], background: NDArray[np.bool_],
+           n_in: NDArray[np.float64], ab: NDArray[np.int64], extent: float, front: float, hidden_frac: float
+           ) -> NDArray[np.bool_]:
+    """Surfaces (by label) that make one object with surface ``main`` (see ``surface_mask``)."""
+    z0 = zmean[main]
+    ok_l = ~background & (n_in > 0) & (zmean <= z0 + extent) & (zmean >= z0 - front) & ~(
+        (hidden > hidden_frac) & (zmean > z0))
+    ok_l[0] = False
+    ok_l[main] = True
+    # Surfaces join only through touching accepted surfaces: a same-depth blob elsewhere in the box
+    # is another thing.
+    e = ab[:, ok_l[ab[0]] & ok_l[ab[1]]]
+    nb = len(zmean)
+    _, comp = connected_components(coo_matrix((np.ones(e.shape[1]), (e[0], e[1])), shape=(nb, nb)), directed=False)
+    return ok_l & (comp == comp[main])
+
+
+def surface_mask(depth: NDArray[np.floating], box_px: tuple[int, int, int, int],
+                 exclude: NDArray[np.bool_] | None = None, extent: float = 1.5, gap: float = 0.04,
+                 gap_rel: float = 0.02, ring: float = 0.1, side_frac: float = 0.3, hidden_frac: float = 0.5,
+                 min_valid: int = 4, min_share: float = 0.02, front: float = 0.75, kink: float = 0.03,
+                 max_leads: int = 8, fill_tol: float = 0.8) -> NDArray[np.bool_] | None:
+    """The object's own surfaces in the pixel window ``box_px`` (x0, y0, x1, y1), or None.
+
+    A box from a detector frames one object; what else it catches is background, seen around
+    the object or through it (an open chair back, the gap under a table). The window grown by a
+    ``ring`` of its size is cut into smooth surfaces at depth jumps (``depth_jumps``, far side
+    only, so a one-pixel chair leg stays whole) and creases (``depth_kinks``); cut pixels rejoin
+    the neighbour of nearest depth. For each surface: its pixels in the box, how much of each ring
+    side (above, below, left, right of the box) it covers, and the share of its outline (next to
+    anything else, the floor and invalid pixels included) where it is the far side (``hidden``).
+    A surface covering at least ``side_frac`` of two ring sides runs on past the object (a wall,
+    the floor, a far room) and is background. Each of the ``max_leads`` largest surfaces (at
+    least ``min_share`` of the box's valid pixels, not mostly hidden) leads a group; the surfaces
+    touching the group join it unless they are background, lie more than ``extent`` metres
+    behind the lead's mean depth or ``front`` metres before it (an occluder), or are mostly
+    hidden (share > ``hidden_frac``) and behind it (the wall between chair slats or table legs).
+    A detector draws its box around the object, so the groups whose bounding rectangle fills at
+    least ``fill_tol`` of the best filling one compete; the one whose lead has most box pixels,
+    weighted by how little of its outline is hidden, wins (an object occludes what lies behind
+    it, never the reverse). None when no surface qualifies (``depth_box_mask`` then falls back to
+    ``method="mode"``).
+    """
+    z_all = np.asarray(depth, dtype=np.float64)
+    h, w = z_all.shape
+    c0, r0, c1, r1 = box_px
+    bh, bw = r1 - r0, c1 - c0
+    if bh <= 0 or bw <= 0:
+        return None
+    mr, mc = max(2, round(ring * bh)), max(2, round(ring * bw))
+    R0, R1, C0, C1 = max(0, r0 - mr), min(h, r1 + mr), max(0, c0 - mc), min(w, c1 + mc)
+    z = z_all[R0:R1, C0:C1]
+    with np.errstate(invalid="ignore"):
+        ok = np.isfinite(z) & (z > 0)
+    if exclude is not None:
+        ok &= ~np.asarray(exclude, dtype=bool)[R0:R1, C0:C1]
+    z = np.where(ok, z, 0.0)
+    inb = np.zeros(z.shape, dtype=bool)
+    inb[r0 - R0: r1 - R0, c0 - C0: c1 - C0] = True
+    n_valid = int((ok & inb).sum())
+    if n_valid < max(1, min_valid):
+        return None
+    tol = gap + gap_rel * z
+    jump = depth_jumps(z, ok, gap, gap_rel, far_only=True) | depth_kinks(z, ok, kink, 0.5 * gap_rel)
+    labels, n = ndimage.label(ok & ~jump)
+    if n == 0:
+        return None
+    labels = _attach(z, labels.astype(np.int64), ok & jump, tol)
+    nb = n + 1
+    n_in = np.bincount(labels[inb], minlength=nb).astype(np.float64)
+    n_in[0] = 0.0
+    count = np.bincount(labels.ravel(), minlength=nb).astype(np.float64)
+    zmean = np.bincount(labels.ravel(), weights=z.ravel(), minlength=nb) / np.maximum(count, 1.0)
+    sides = np.zeros(nb, dtype=np.int64)
+    rows, cols = slice(r0 - R0, r1 - R0), slice(c0 - C0, c1 - C0)
+    for strip in (labels[: r0 - R0, cols], labels[r1 - R0:, cols], labels[rows, : c0 - C0], labels[rows, c1 - C0:]):
+        if strip.size:
+            sides += np.bincount(strip.ravel(), minlength=nb) >= side_frac * strip.size
+    background = sides >= 2
+    # Outline pairs (4-neighbours with different labels): which side is farther.
+    hid = np.zeros(nb)
+    edge = np.zeros(nb)
+    pairs: list[NDArray[np.int64]] = []
+    for a_l, b_l, a_z, b_z in ((labels[1:], labels[:-1], z[1:], z[:-1]),
+                               (labels[:, 1:], labels[:, :-1], z[:, 1:], z[:, :-1])):
+        diff = a_l != b_l
+        edge += np.bincount(a_l[diff], minlength=nb) + np.bincount(b_l[diff], minlength=nb)  # whole outline
+        pair = diff & (a_l > 0) & (b_l > 0)
+        la, lb, za, zb = a_l[pair], b_l[pair], a_z[pair], b_z[pair]
+        hid += np.bincount(la, weights=(za > zb).astype(np.float64), minlength=nb)
+        hid += np.bincount(lb, weights=(zb > za).astype(np.float64), minlength=nb)
+        pairs.append(np.stack([la, lb]))
+    hidden = hid / np.maximum(edge, 1.0)
+    lead = ~background & (n_in >= max(float(min_valid), min_share * n_valid)) & (hidden <= hidden_frac)
+    lead[0] = False
+    if not lead.any():
+        return None
+    ab = np.concatenate(pairs, axis=1)
+    spans = ndimage.find_objects(labels)
+    lo = np.array([[s_[0].start, s_[1].start] if s_ is not None else [1 << 30, 1 << 30] for s_ in spans])
+    hi = np.array([[s_[0].stop, s_[1].stop] if s_ is not None else [-1, -1] for s_ in spans])
+    box_area = float(bh * bw)
+    b_lo, b_hi = np.array([r0 - R0, c0 - C0]), np.array([r1 - R0, c1 - C0])
+    order = np.argsort(-np.where(lead, n_in * (1.0 - hidden), -1.0))[: max(1, max_leads)]
+    groups: list[tuple[float, float, NDArray[np.bool_]]] = []
+    for main in order[lead[order]]:
+        keep = _group(int(main), zmean, hidden, background, n_in, ab, extent, front, hidden_frac)
+        members = np.flatnonzero(keep) - 1
+        g_lo = np.maximum(lo[members].min(axis=0), b_lo)
+        g_hi = np.minimum(hi[members].max(axis=0), b_hi)
+        fill = float(np.prod(np.maximum(g_hi - g_lo, 0))) / box_area  # the box is drawn around the object
+        groups.append((fill, float(n_in[main] * (1.0 - hidden[main])), keep))
+    top = max(g[0] for g in groups)
+    keep = max((g for g in groups if g[0] >= fill_tol * top), key=lambda g: g[1])[2]
+    mask = np.zeros((h, w), dtype=bool)
+    mask[R0:R1, C0:C1] = keep[labels] & inb
+    return mask
 
 
 def floor_pixels(depth: NDArray[np.floating], K: Any, T_wc: NDArray[np.floating], height: float = 0.05
