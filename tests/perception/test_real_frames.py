@@ -182,3 +182,11 @@ def test_capnav_map_says_why_a_map_is_empty(real: Path, shared_dir: Path, tmp_pa
     assert "0 objects" in out and "nan" not in out
     assert "skipped 2 frames (first: 1): missing" in out and out.count("skipped") == 1  # one line per reason
     assert "warning: the map has 0 objects: the detector found nothing it keeps" in out
+
+
+def test_sim_detector_is_refused_on_real_frames(real: Path) -> None:
+    from _synth_scene import HashEmbedder
+
+    m = Mapper(MapperConfig(), create_detector("sim"), create_encoder("label-embedding", embedder=HashEmbedder()))
+    with pytest.raises(InputError, match=r"frame 0 has no simulator truth images .* centernet, owl or yolo-fastest"):
+        m.integrate(_frame(real, "nyu"))

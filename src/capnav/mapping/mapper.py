@@ -23,7 +23,7 @@ from capnav.mapping.objects import Observation
 from capnav.mapping.occupancy import OccupancyConfig, occupancy_from_voxels
 from capnav.mapping.tracker import SG3DTracker, TrackerConfig
 from capnav.mapping.voxel_map import VoxelConfig, VoxelMap, random_projection
-from capnav.perception.base import DenseFeatureEncoder, Detector, validate_detections
+from capnav.perception.base import DenseFeatureEncoder, Detector, needs_truth_error, validate_detections
 
 log = logging.getLogger(__name__)
 
@@ -116,6 +116,8 @@ class Mapper:
             frame.validate(max_invalid_fraction=self.config.max_invalid_depth)
         except FrameError as e:
             return self._bad(e)
+        if self.detector.needs_truth and frame.gt_instance is None and not self.frames_used:
+            raise needs_truth_error(self.detector, f"frame {frame.index}")  # a stream of real frames
         try:
             dets = validate_detections(frame, self.detector.detect(frame))
         except Exception as e:  # any detector failure: the frame's geometry still counts

@@ -5,12 +5,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from capnav.core.errors import FrameError, InputError
+from capnav.core.errors import FrameError
 from capnav.core.progress import track
 from capnav.io.dataset import DatasetReader
 from capnav.mapping.cmap import CapNavMap
 from capnav.mapping.mapper import Mapper, MapperConfig
-from capnav.perception.base import DETECTORS, DenseFeatureEncoder, Detector
+from capnav.perception.base import DenseFeatureEncoder, Detector, needs_truth_error
 
 
 def map_dataset(path: str | Path | DatasetReader, detector: Detector, encoder: DenseFeatureEncoder,
@@ -20,10 +20,7 @@ def map_dataset(path: str | Path | DatasetReader, detector: Detector, encoder: D
     reader = path if isinstance(path, DatasetReader) else DatasetReader(path)
     path = reader.path
     if detector.needs_truth and not reader.has_gt:
-        real = [n for n in DETECTORS.names() if n != "sim"]
-        raise InputError(f"{path} has no simulator truth images (gt_instance/gt_category), which detector "
-                         f"{detector.id.split(':')[0]!r} reads; use a detector for real images: "
-                         f"{', '.join(real[:-1])} or {real[-1]} (docs/perception.md)")
+        raise needs_truth_error(detector, str(path))
     mapper = Mapper(config, detector, encoder)
     n = len(reader) if max_frames is None else min(len(reader), max_frames)
     for i in track(range(n), "mapping", total=n, enabled=progress):

@@ -17,7 +17,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import NDArray
 
-from capnav.core.errors import FrameError
+from capnav.core.errors import FrameError, InputError
 from capnav.core.frame import Frame
 from capnav.core.registry import Registry
 
@@ -121,6 +121,15 @@ class DenseFeatureEncoder(ABC):
             raise FrameError(frame.index, f"encoder {self.id} returned shape {phi.shape}, expected (H', W', D)")
         hh, ww, d = phi.shape
         return np.arange(hh * ww, dtype=np.int64).reshape(hh, ww), phi.reshape(hh * ww, d)
+
+
+def needs_truth_error(detector: Detector, where: str) -> InputError:
+    """The one-line refusal of a truth-reading detector (``sim``) on data without truth images,
+    naming the detectors that work on real images."""
+    real = [n for n in DETECTORS.names() if n != "sim"]
+    return InputError(f"{where} has no simulator truth images (gt_instance/gt_category), which detector "
+                      f"{detector.id.split(':')[0]!r} reads; use a detector for real images: "
+                      f"{', '.join(real[:-1])} or {real[-1]} (docs/perception.md)")
 
 
 DETECTORS: Registry[Detector] = Registry("detector")
