@@ -1,0 +1,363 @@
+"""Build CapNav's word lexicon (``src/capnav/language/data/lexicon.json``) from WordNet 3.0, once.
+
+Run it after changing the category vocabulary or the choices below; the test
+``tests/language/test_lexicon.py`` rebuilds it from /usr/share/wordnet and checks that the shipped
+file is identical. Runtime never imports nltk: it reads the JSON.
+
+    python scripts/build_lexicon.py [--wordnet /usr/share/wordnet] [-o src/capnav/language/data/lexicon.json]
+
+Needs ``nltk``, ``stop-words`` and ``scikit-learn`` (the ``dev`` extra) and Debian's ``wordnet-base`` +
+``wordnet-sense-index``. nltk's reader takes those files once they are copied (not linked) into
+``DIR/corpora/wordnet/`` with a ``lexnames`` file added (Debian ships that table only in the
+lexnames(5WN) man page; it is the fixed table below).
+
+What the lexicon holds, and the choices made (WordNet's senses do not always match how a home robot
+is spoken to):
+
+- ``forms``: surface form -> category, for every lemma of the category's synsets and of their
+  hyponyms. A lemma counts only when its most frequent *physical* sense (noun.artifact or
+  noun.plant; abstract senses such as chair = "professorship" are ignored) lies under the
+  category: "press" (a printing press first), "can" or "pot" (containers first) do not become a
+  wardrobe or a toilet, while "commode" (toilet first, chest of drawers second) is a toilet with
+  the dresser as an alternative. Lemmas that are colour or room words are left out ("lounge" is a
+  room in CapNav's room words). The category's own names and synonyms from
+  ``capnav.core.categories`` are always forms.
+- Synsets chosen per category (``ROOTS``): settee's first WordNet sense is ``settle.n.01`` (a
+  bench with a back), but people say settee for a small sofa and CapNav has no bench, so
+  ``settle.n.01`` is put with the sofa. Easy chairs (lounge chair, wing chair, recliner) are
+  armchairs, which WordNet puts under armchair already except ``easy_chair.n.01`` itself. The
+  plant category is a potted indoor plant: WordNet's ``plant.n.02`` covers every organism of the
+  plant kingdom (and its lemmas include olive, orange, rose), so only houseplants, pot plants,
+  succulents (cactus, aloe), ferns, palms and bonsai are taken. WordNet 3.0 has no nightstand
+  (bedside table): its nearest synset, ``stand.n.04`` (a small table for holding articles), gives
+  the nightstand's gloss. The counter is ``counter.n.01`` without its hyponyms (shop counters,
+  bars, checkouts) plus the countertop. The toilet includes the British
+  ``water_closet.n.01`` (loo) although WordNet files it as a room. Lamps are ``lamp.n.02`` (the
+  furniture), not ``lamp.n.01`` (any source of light: torches, searchlights).
+- ``other``: compounds whose last word is a category word but which name something else (a pool
+  table, a toilet seat, a power plant): game, operating, altar and work tables, wheelchairs,
+  hospital beds (``EXCLUDE``), and every WordNet noun ending in a category word whose first physical sense
+  is outside that category. "the pool table" is then an object CapNav does not know, not a table.
+- ``relations``: for each ordered pair of categories, ``kind_of`` when one's synsets lie under the
+  other's (an armchair is a chair; a coffee table, a desk, a nightstand and a counter are tables)
+  and the Wu-Palmer similarity of their first synsets (chair-stool 0.9, chair-sofa 0.87): the
+  parser turns these into weighted alternative categories.
+- ``glosses``: WordNet's definitions and examples of each category's synsets and their direct
+  hyponyms, for requests by purpose ("somewhere to sit" is matched to them with the text embedder).
+- ``foreign``: function words of French, Spanish, German, Italian, Portuguese and Dutch (from the
+  ``stop-words`` package) that are not English: not an English stop word (scikit-learn's list) and
+  not a WordNet lemma
+  that occurs in lower case in its sense-tagged corpus (``cntlist``; "LA" the state does not make
+  "la" English); they mark an instruction as not English (``capnav.retrieval.query`` says when).
+
+WordNet's licence notice is copied beside the data (``WORDNET_LICENSE``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "src"))
+
+from capnav.core.categories import CATEGORIES  # noqa: E402
+from capnav.language.colors import ALIASES, LEXICON  # noqa: E402
+
+#: lexnames(5WN): file number -> lexicographer file name (a fixed table of WordNet 3.0).
+LEXNAMES = ("adj.all adj.pert adv.all noun.Tops noun.act noun.animal noun.artifact noun.attribute noun.body "
+            "noun.cognition noun.communication noun.event noun.feeling noun.food noun.group noun.location "
+            "noun.motive noun.object noun.person noun.phenomenon noun.plant noun.possession noun.process "
+            "noun.quantity noun.relation noun.shape noun.state noun.substance noun.time verb.body verb.change "
+            "verb.cognition verb.communication verb.competition verb.consumption verb.contact verb.creation "
+            "verb.emotion verb.motion verb.perception verb.possession verb.social verb.stative verb.weather "
+            "adj.ppl").split()
+
+#: Category -> WordNet synsets whose lemmas and hyponyms' lemmas name it (see the module docstring).
+ROOTS: dict[str, list[str]] = {
+    "sofa": ["sofa.n.01", "settle.n.01", "sectional.n.01"],
+    "armchair": ["armchair.n.01"],
+    "chair": ["chair.n.01"],
+    "stool": ["stool.n.01"],
+    "table": ["table.n.02", "table.n.03"],
+    "coffee table": ["coffee_table.n.01"],
+    "desk": ["desk.n.01", "writing_desk.n.01", "secretary.n.02"],
+    "bed": ["bed.n.01"],
+    "nightstand": ["stand.n.04"],
+    "wardrobe": ["wardrobe.n.01"],
+    "dresser": ["chest_of_drawers.n.01"],
+    "cabinet": ["cabinet.n.01", "buffet.n.01", "cupboard.n.01"],
+    "bookshelf": ["bookshelf.n.01", "bookcase.n.01"],
+    "tv": ["television_receiver.n.01"],
+    "lamp": ["lamp.n.02"],
+    "plant": ["houseplant.n.01", "pot_plant.n.01", "succulent.n.01", "fern.n.01", "palm.n.03", "bonsai.n.01"],
+    "toilet": ["toilet.n.02", "water_closet.n.01"],
+    "sink": ["sink.n.01", "washbasin.n.02"],
+    "bathtub": ["bathtub.n.01"],
+    "refrigerator": ["refrigerator.n.01"],
+    "counter": ["counter.n.01!", "countertop.n.01"],
+    "stove": ["stove.n.01", "oven.n.01"],
+    "washing machine": ["washer.n.03"],
+    "ottoman": ["ottoman.n.03", "footstool.n.01"],
+}
+
+#: Branches under the roots that are not the household object (their lemmas become ``other``).
+EXCLUDE = ["pool_table.n.01", "card_table.n.01", "gaming_table.n.01", "table-tennis_table.n.01",
+           "operating_table.n.01", "altar.n.01", "worktable.n.01", "platen.n.01", "booth.n.01", "lectern.n.01",
+           "wheelchair.n.01", "barber_chair.n.01", "throne.n.01", "electric_chair.n.01", "highchair.n.01",
+           "deathbed.n.02", "sickbed.n.01", "hospital_bed.n.01", "hammock.n.02", "chamberpot.n.01",
+           "toilet_seat.n.01", "medicine_chest.n.01"]
+#: Synsets whose hyponyms (not themselves) are excluded: shop counters, bars and checkouts.
+EXCLUDE_HYPONYMS_OF = ["counter.n.01"]
+
+PHYSICAL = {"noun.artifact", "noun.plant"}
+#: Senses of other concrete things that outrank a furniture sense ("squab" is a pigeon first).
+CONCRETE = PHYSICAL | {"noun.animal", "noun.food", "noun.person", "noun.object", "noun.body", "noun.substance"}
+MAX_GLOSSES = 12
+ROOM_WORDS = {"kitchen", "bedroom", "bathroom", "lounge", "study", "office", "hall", "hallway", "room"}
+FOREIGN_LANGUAGES = ("french", "spanish", "german", "italian", "portuguese", "dutch")
+
+
+def open_wordnet(source: Path, workdir: Path) -> Any:
+    """nltk's WordNet reader over Debian's files, without any download."""
+    import nltk  # build-time only (the dev extra)
+
+    target = workdir / "corpora" / "wordnet"
+    target.mkdir(parents=True)
+    for f in source.iterdir():
+        if f.is_file():
+            shutil.copyfile(f, target / f.name)
+    with open(target / "lexnames", "w") as fh:
+        pos = {"noun": 1, "verb": 2, "adj": 3, "adv": 4}
+        for i, name in enumerate(LEXNAMES):
+            fh.write(f"{i:02d}\t{name}\t{pos[name.split('.')[0]]}\n")
+    nltk.data.path.insert(0, str(workdir))
+    from nltk.corpus.reader.wordnet import WordNetCorpusReader
+
+    return WordNetCorpusReader(str(target), None)
+
+
+def _form(lemma: str) -> str:
+    return lemma.replace("_", " ").lower()
+
+
+def build(wordnet: Path) -> dict[str, Any]:
+    with tempfile.TemporaryDirectory() as tmp:
+        wn = open_wordnet(wordnet, Path(tmp))
+        return _build(wn)
+
+
+def _closure(wn: Any, names: list[str], excluded: set[str]) -> set[str]:
+    """The synsets and their hyponyms (a name ending in "!" is taken without its hyponyms)."""
+    out = {n[:-1] for n in names if n.endswith("!")}
+    stack = [wn.synset(n) for n in names if not n.endswith("!")]
+    while stack:
+        s = stack.pop()
+        if s.name() in out or s.name() in excluded:
+            continue
+        out.add(s.name())
+        stack.extend(s.hyponyms())
+    return out
+
+
+def _build(wn: Any) -> dict[str, Any]:
+    excluded = {s.name() for n in EXCLUDE for s in wn.synset(n).closure(lambda x: x.hyponyms())} | set(EXCLUDE)
+    excluded |= {s.name() for n in EXCLUDE_HYPONYMS_OF for s in wn.synset(n).closure(lambda x: x.hyponyms())}
+    members = {cat: _closure(wn, roots, excluded) for cat, roots in ROOTS.items()}
+    # A synset under two categories' roots belongs to the more specific one (the smaller closure).
+    owner: dict[str, str] = {}
+    for cat in sorted(members, key=lambda c: len(members[c]), reverse=True):
+        for s in members[cat]:
+            owner[s] = cat
+    colour_words = set(LEXICON) | set(ALIASES)
+    fixed = {f: c.name for c in CATEGORIES for f in (c.name, *c.synonyms)}
+    forms: dict[str, str] = dict(fixed)
+    alternatives: dict[str, dict[str, float]] = {}
+
+    def physical_senses(lemma: str) -> list[Any]:
+        # Senses where the word is written in lower case: Chesterfield the statesman is no sofa.
+        return [s for s in wn.synsets(lemma, "n") if s.lexname() in CONCRETE
+                and any(lem.name() == lemma for lem in s.lemmas())]
+
+    def other_parts_of_speech(lemma: str) -> bool:
+        return any(wn.synsets(lemma, pos) for pos in ("v", "a", "s", "r"))
+
+    candidates = sorted({lem.name() for s in owner for lem in wn.synset(s).lemmas()})
+    for lemma in candidates:
+        form = _form(lemma)
+        if lemma != lemma.lower() or form in fixed or form in colour_words or form in ROOM_WORDS:
+            continue
+        if len(form.split()) > 3 or not all(ch.isalpha() or ch in " -'" for ch in form):
+            continue
+        if " " not in form and other_parts_of_speech(lemma):
+            continue  # "settle", "lower", "console", "palm": a verb or adjective first in speech
+        senses = physical_senses(lemma)
+        if not senses or senses[0].name() not in owner:
+            continue
+        cat = owner[senses[0].name()]
+        forms[form] = cat
+        others = {owner[s.name()] for s in senses[1:] if s.name() in owner} - {cat}
+        if others:
+            alternatives[form] = {o: 0.5 for o in sorted(others)}
+    # Compounds ending in a category word that are something else.
+    heads = {f.split()[-1] for f in forms}
+    other: list[str] = []
+    for lemma in wn.all_lemma_names("n"):
+        form = _form(lemma)
+        words = form.split()
+        if len(words) < 2 or len(words) > 3 or words[-1] not in heads or form in forms or lemma != lemma.lower():
+            continue
+        senses = physical_senses(lemma)
+        if senses and senses[0].name() not in owner:
+            other.append(form)
+    # Relations between categories.
+    relations: dict[str, dict[str, dict[str, float | bool]]] = {}
+    for a, ra in ROOTS.items():
+        row: dict[str, dict[str, float | bool]] = {}
+        for b, rb in ROOTS.items():
+            if a == b:
+                continue
+            kind_of = any(n.rstrip("!") in members[a] for n in rb)
+            wup = float(wn.synset(ra[0].rstrip("!")).wup_similarity(wn.synset(rb[0].rstrip("!"))) or 0.0)
+            if kind_of or wup >= 0.7:
+                row[b] = {"kind_of": kind_of, "wup": round(wup, 3)}
+        relations[a] = row
+    # Glosses for purposes.
+    glosses: dict[str, list[str]] = {}
+    for cat, roots in ROOTS.items():
+        texts: list[str] = []
+        for n in roots:
+            s = wn.synset(n.rstrip("!"))
+            for t in (s.definition(), *s.examples()):
+                texts.append(t)
+            for h in sorted(s.hyponyms(), key=lambda x: x.name()):
+                if h.name() in owner and owner[h.name()] == cat:
+                    texts.append(h.definition())
+        glosses[cat] = list(dict.fromkeys(t.strip() for t in texts if t.strip()))[:MAX_GLOSSES]
+    return {"forms": dict(sorted(forms.items())), "alternatives": dict(sorted(alternatives.items())),
+            "other": sorted(set(other)), "relations": relations, "glosses": glosses,
+            "foreign": _foreign(wn), "english": _english(), "not_typos": _not_typos(wn),
+            "source": "WordNet 3.0 (Princeton University), see WORDNET_LICENSE",
+            "roots": ROOTS, "exclude": EXCLUDE}
+
+
+#: Words the parser corrects typos towards besides category, colour and room words.
+TYPO_KEYWORDS = ["beside", "near", "next", "behind", "opposite", "front", "closest", "nearest", "farthest",
+                 "furthest", "biggest", "largest", "smallest"]
+
+
+def _not_typos(wn: Any) -> list[str]:
+    """Common English words (lower-case WordNet lemmas seen in its sense-tagged corpus, of similar
+    length and with the same first letter) that look like a word the parser corrects typos
+    towards: "store" is no typo of "stove", nor "write" of "white"."""
+    import difflib
+
+    from capnav.language.colors import SHADES
+
+    targets = {w for c in CATEGORIES for f in (c.name, *c.synonyms) for w in f.split()}
+    targets |= {w + "s" for w in targets} | {w for f in (*LEXICON, *ALIASES, *SHADES) for w in f.split()}
+    targets |= ROOM_WORDS | set(TYPO_KEYWORDS)
+    # Candidates of similar length that share the first letter (typos rarely change it).
+    by_key: dict[tuple[str, int], list[str]] = {}
+    for lemma in wn.all_lemma_names():
+        if lemma == lemma.lower() and lemma.isalpha() and len(lemma) >= 3 and lemma not in targets:
+            by_key.setdefault((lemma[0], len(lemma)), []).append(lemma)
+    near: set[str] = set()
+    for t in sorted(targets):
+        pool = [w for n in range(len(t) - 2, len(t) + 3) for w in by_key.get((t[0], n), [])]
+        near.update(difflib.get_close_matches(t, pool, n=100, cutoff=0.75))
+    out = {w for w in near if any(lem.count() > 0 for lem in wn.lemmas(w) if lem.name() == w)}
+    return sorted(out)
+
+
+def _other_stop_words() -> set[str]:
+    from stop_words import get_stop_words  # build-time only (the dev extra)
+
+    return {w.lower().strip() for lang in FOREIGN_LANGUAGES for w in get_stop_words(lang)}
+
+
+def _english_stop_words() -> set[str]:
+    # scikit-learn's list (the Glasgow IR group's): stop-words' own English list also holds "la",
+    # "il" and "et", so it cannot tell English from French.
+    from sklearn.feature_extraction.text import ENGLISH_STOP_WORDS
+
+    return {str(w) for w in ENGLISH_STOP_WORDS}
+
+
+def _english() -> list[str]:
+    """English function words that are no function word of the six other languages ("the", "to",
+    "near"; not "a", "in", "de"): their presence marks a sentence as English."""
+    others = _other_stop_words()
+    return sorted(w for w in _english_stop_words() if w.isalpha() and w not in others)
+
+
+def _foreign(wn: Any) -> list[str]:
+    english = _english_stop_words()
+    out: set[str] = set()
+    for w in sorted(_other_stop_words()):
+        if len(w) < 2 or not w.replace("'", "").isalpha() or w in english:
+            continue
+        if not any(lem.count() > 0 for lem in wn.lemmas(w) if lem.name() == w):  # lower case: not "LA"
+            out.add(w)
+    return sorted(out)
+
+
+LICENSE = """WordNet Release 3.0 (the lexicon in lexicon.json is derived from it)
+
+This software and database is being provided to you, the LICENSEE, by
+Princeton University under the following license.  By obtaining, using
+and/or copying this software and database, you agree that you have
+read, understood, and will comply with these terms and conditions.:
+
+Permission to use, copy, modify and distribute this software and
+database and its documentation for any purpose and without fee or
+royalty is hereby granted, provided that you agree to comply with
+the following copyright notice and statements, including the disclaimer,
+and that the same appear on ALL copies of the software, database and
+documentation, including modifications that you make for internal
+use or for distribution.
+
+WordNet 3.0 Copyright 2006 by Princeton University.  All rights reserved.
+
+THIS SOFTWARE AND DATABASE IS PROVIDED "AS IS" AND PRINCETON
+UNIVERSITY MAKES NO REPRESENTATIONS OR WARRANTIES, EXPRESS OR
+IMPLIED.  BY WAY OF EXAMPLE, BUT NOT LIMITATION, PRINCETON
+UNIVERSITY MAKES NO REPRESENTATIONS OR WARRANTIES OF MERCHANT-
+ABILITY OR FITNESS FOR ANY PARTICULAR PURPOSE OR THAT THE USE
+OF THE LICENSED SOFTWARE, DATABASE OR DOCUMENTATION WILL NOT
+INFRINGE ANY THIRD PARTY PATENTS, COPYRIGHTS, TRADEMARKS OR
+OTHER RIGHTS.
+
+The name of Princeton University or Princeton may not be used in
+advertising or publicity pertaining to distribution of the software
+and/or database.  Title to copyright in this software, database and
+any associated documentation shall at all times remain with
+Princeton University and LICENSEE agrees to preserve same.
+"""
+
+
+def dumps(lexicon: dict[str, Any]) -> str:
+    return json.dumps(lexicon, indent=1, sort_keys=False, ensure_ascii=False) + "\n"
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--wordnet", default="/usr/share/wordnet", help="WordNet 3.0 database folder")
+    ap.add_argument("-o", "--output", default=str(ROOT / "src/capnav/language/data/lexicon.json"))
+    args = ap.parse_args()
+    out = Path(args.output)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    lex = build(Path(args.wordnet))
+    out.write_text(dumps(lex))
+    (out.parent / "WORDNET_LICENSE").write_text(LICENSE)
+    print(f"wrote {out}: {len(lex['forms'])} forms, {len(lex['other'])} other compounds, "
+          f"{sum(len(g) for g in lex['glosses'].values())} glosses, {len(lex['foreign'])} foreign words")
+
+
+if __name__ == "__main__":
+    main()

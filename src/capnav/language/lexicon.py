@@ -1,0 +1,77 @@
+"""Object words from WordNet 3.0: which category a word names, which categories are related, and
+what each category is for.
+
+Why: hand-written synonym tables miss what people say ("cactus", "loveseat", "wing chair",
+"credenza"), and a strict category makes "the pink chair" never consider the pink armchair.
+``scripts/build_lexicon.py`` builds ``data/lexicon.json`` from WordNet once (its docstring says
+which senses were chosen and why); this module only reads that JSON, once per process.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass
+from functools import lru_cache
+from importlib import resources
+from typing import Any
+
+from capnav.core.errors import CapNavError
+
+#: Weight of a category that is a kind of the requested one (an armchair for "chair"), of a more
+#: general one (a chair for "armchair"), and of a close sibling (a stool for "chair", Wu-Palmer
+#: similarity >= ``SIBLING_WUP``): always below 1, so instances of the named category come first.
+KIND_OF_WEIGHT = 0.8
+GENERAL_WEIGHT = 0.5
+SIBLING_WEIGHT = 0.3
+SIBLING_WUP = 0.9
+
+
+@dataclass(frozen=True)
+class Lexicon:
+    forms: dict[str, str]  # surface form ("loveseat") -> category ("sofa")
+    form_alternatives: dict[str, dict[str, float]]  # a form's other senses ("commode": dresser)
+    other: frozenset[str]  # compounds that end in a category word but name something else
+    relations: dict[str, dict[str, dict[str, Any]]]  # category -> category -> {"kind_of", "wup"}
+    glosses: dict[str, tuple[str, ...]]  # category -> definitions (for requests by purpose)
+    foreign: frozenset[str]  # function words of other languages that are not English words
+    english: frozenset[str]  # English function words that no other of those languages uses
+    not_typos: frozenset[str]  # common words that look like a category or colour word ("store")
+    load_seconds: float = 0.0
+
+    def category_alternatives(self, category: str, form: str | None = None) -> dict[str, float]:
+        """Other categories a request for ``category`` may be served by, each with a weight < 1."""
+        out: dict[str, float] = {}
+        for other, rel in self.relations.get(category, {}).items():
+            if rel.get("kind_of"):
+                out[other] = KIND_OF_WEIGHT
+            elif self.relations.get(other, {}).get(category, {}).get("kind_of"):
+                out[other] = GENERAL_WEIGHT
+            elif float(rel.get("wup", 0.0)) >= SIBLING_WUP:
+                out[other] = SIBLING_WEIGHT
+        if form is not None:
+            for other, w in self.form_alternatives.get(form, {}).items():
+                out[other] = max(out.get(other, 0.0), float(w))
+        out.pop(category, None)
+        return dict(sorted(out.items(), key=lambda kv: (-kv[1], kv[0])))
+
+
+@lru_cache(maxsize=1)
+def load_lexicon() -> Lexicon:
+    """The shipped lexicon (read once per process; ``load_seconds`` says how long that took)."""
+    t0 = time.perf_counter()
+    try:
+        raw = json.loads(resources.files("capnav.language").joinpath("data/lexicon.json").read_text("utf-8"))
+    except (OSError, ValueError) as e:
+        raise CapNavError(f"the word lexicon (capnav/language/data/lexicon.json) cannot be read: {e}; "
+                          "rebuild it with `python scripts/build_lexicon.py`") from None
+    lex = Lexicon(forms=dict(raw["forms"]), form_alternatives=raw.get("alternatives", {}),
+                  other=frozenset(raw.get("other", [])), relations=raw.get("relations", {}),
+                  glosses={k: tuple(v) for k, v in raw.get("glosses", {}).items()},
+                  foreign=frozenset(raw.get("foreign", [])), english=frozenset(raw.get("english", [])),
+                  not_typos=frozenset(raw.get("not_typos", [])))
+    object.__setattr__(lex, "load_seconds", time.perf_counter() - t0)
+    return lex
+
+
+__all__ = ["Lexicon", "load_lexicon"]

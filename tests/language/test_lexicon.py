@@ -1,0 +1,74 @@
+"""The WordNet lexicon: rebuilt from the system's WordNet it equals the shipped file; the words it
+adds reach their categories; related categories are weighted alternatives."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import os
+from pathlib import Path
+
+import pytest
+
+from capnav.language.lexicon import KIND_OF_WEIGHT, load_lexicon
+
+REPO = Path(__file__).resolve().parents[2]
+WORDNET = Path("/usr/share/wordnet")
+
+
+def test_shipped_lexicon_is_what_the_script_builds_from_wordnet():
+    if not (WORDNET / "data.noun").exists() or importlib.util.find_spec("nltk") is None:
+        if os.environ.get("CI"):
+            pytest.fail("CI must have WordNet (wordnet-base) and nltk (dev extra) to check the lexicon")
+        pytest.skip("WordNet 3.0 (/usr/share/wordnet) or nltk is not installed")
+    spec = importlib.util.spec_from_file_location("build_lexicon", REPO / "scripts" / "build_lexicon.py")
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    built = mod.dumps(mod.build(WORDNET))
+    shipped = (REPO / "src/capnav/language/data/lexicon.json").read_text("utf-8")
+    assert json.loads(built) == json.loads(shipped), "run `python scripts/build_lexicon.py` and commit the result"
+    assert (REPO / "src/capnav/language/data/WORDNET_LICENSE").read_text() == mod.LICENSE
+
+
+@pytest.mark.parametrize(("word", "category"), [
+    ("cactus", "plant"), ("fern", "plant"), ("settee", "sofa"), ("loveseat", "sofa"), ("chesterfield", "sofa"),
+    ("wing chair", "armchair"), ("recliner", "armchair"), ("credenza", "cabinet"), ("commode", "toilet"),
+    ("chiffonier", "dresser"), ("tallboy", "dresser"), ("bunk bed", "bed"), ("hassock", "ottoman"),
+    ("icebox", "refrigerator"), ("washbasin", "sink"), ("armoire", "wardrobe"), ("cocktail table", "coffee table"),
+])
+def test_wordnet_words_reach_their_category(word, category):
+    assert load_lexicon().forms[word] == category
+
+
+def test_chosen_senses_and_left_out_words():
+    lex = load_lexicon()
+    # Verbs/adjectives first in speech, and colour or room words, are no furniture words.
+    for w in ("settle", "lower", "console", "palm", "press", "can", "pot", "olive", "lounge"):
+        assert w not in lex.forms, w
+    # Compounds that end in a category word but are something else.
+    for w in ("pool table", "power plant", "toilet seat", "operating table"):
+        assert w in lex.other and w not in lex.forms, w
+
+
+def test_related_categories_are_weighted_below_one():
+    lex = load_lexicon()
+    chair = lex.category_alternatives("chair")
+    assert chair["armchair"] == KIND_OF_WEIGHT  # an armchair is a chair (WordNet hypernym)
+    assert 0 < chair["stool"] < chair["armchair"] < 1  # a sibling under "seat"
+    table = lex.category_alternatives("table")
+    assert {"coffee table", "desk", "nightstand"} <= set(table)
+    assert lex.category_alternatives("armchair")["chair"] < KIND_OF_WEIGHT  # the general word, weaker
+    assert "chair" not in lex.category_alternatives("bed")
+    assert lex.category_alternatives("toilet", "commode") == {"dresser": 0.5}  # the form's second sense
+    assert all(v < 1 for c in lex.relations for v in lex.category_alternatives(c).values())
+
+
+def test_glosses_and_language_words_are_there():
+    lex = load_lexicon()
+    assert all(lex.glosses[c] for c in lex.relations)
+    assert any("sleep" in g for g in lex.glosses["bed"])
+    assert {"la", "le", "der", "und"} <= lex.foreign and not {"the", "to", "in", "a"} & lex.foreign
+    assert {"the", "to"} <= lex.english
+    assert {"store", "write"} <= lex.not_typos
+    assert lex.load_seconds < 1.0
