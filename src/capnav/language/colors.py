@@ -246,11 +246,111 @@ def object_colors(rgb: NDArray[np.generic], config: ColorConfig | None = None) -
     return sorted(merged.values(), key=lambda c: -c.fraction)
 
 
+# -- colours as people say them (queries only; naming keeps the palette above) -----------------
+
+#: Shade words people use that the naming palette has no entry for, with typical sRGB values from
+#: the xkcd colour-name survey. Understood in queries, never used to name a measured colour.
+SHADES: dict[str, tuple[int, int, int]] = {
+    "burgundy": (97, 0, 35), "wine": (128, 1, 63), "maroon": (101, 0, 33), "crimson": (140, 0, 15),
+    "scarlet": (190, 1, 25), "coral": (252, 90, 80), "salmon": (255, 121, 108), "peach": (255, 176, 124),
+    "rust": (168, 60, 9), "burnt orange": (192, 78, 1), "ochre": (191, 144, 5), "gold": (219, 180, 12),
+    "golden": (219, 180, 12), "sand": (226, 202, 118), "taupe": (185, 162, 129), "khaki": (170, 166, 98),
+    "ivory": (255, 255, 203), "off-white": (255, 255, 228), "eggshell": (255, 255, 212), "charcoal": (52, 56, 55),
+    "slate": (81, 101, 114), "ash": (190, 190, 190), "magenta": (194, 0, 120), "hot pink": (255, 2, 141),
+    "rose": (207, 98, 117), "mauve": (174, 113, 129), "lilac": (206, 162, 253), "lavender": (199, 159, 239),
+    "violet": (154, 14, 234), "plum": (88, 15, 65), "indigo": (56, 2, 130), "royal blue": (5, 4, 170),
+    "cobalt": (30, 72, 143), "sky blue": (117, 187, 253), "baby blue": (162, 207, 254), "aqua": (19, 234, 201),
+    "turquoise": (6, 194, 172), "mint": (159, 254, 176), "sage": (135, 174, 115), "lime": (170, 255, 50),
+    "emerald": (1, 160, 73), "forest green": (6, 71, 12), "olive green": (103, 122, 4), "chrome": (197, 201, 199),
+    "steel": (197, 201, 199),
+}
+
+#: Modifiers: how a word moves a colour in CIELAB (lightness change towards white/black as a
+#: fraction, chroma factor). "-ish" words ("reddish") are the base colour made duller.
+_MODIFIERS: dict[str, tuple[float, float]] = {
+    "light": (0.45, 0.75), "pale": (0.5, 0.6), "pastel": (0.45, 0.55), "soft": (0.25, 0.8),
+    "dark": (-0.45, 0.9), "deep": (-0.35, 1.1), "rich": (-0.2, 1.15), "bright": (0.1, 1.25), "vivid": (0.0, 1.3),
+    "dull": (0.0, 0.6), "muted": (0.0, 0.6), "dusty": (0.05, 0.55), "faded": (0.2, 0.55),
+}
+_ISH = (0.0, 0.7)
+#: Wood tones named by their lightness ("dark wooden" is walnut, "light wood" oak).
+_WOODS = {"light wood": "oak", "light wooden": "oak", "dark wood": "walnut", "dark wooden": "walnut"}
+
+
+def _base_lab(word: str) -> F64 | None:
+    w = word.strip().lower()
+    name = canonical_color(w)
+    if name is not None:
+        return np.asarray(LEX_LAB[NAMES.index(name)], dtype=np.float64)
+    if w in SHADES:
+        return srgb_to_lab(np.array(SHADES[w], dtype=np.float64))
+    return None
+
+
+def _de_ish(word: str) -> str | None:
+    """'reddish' -> 'red', 'greyish' -> 'grey', 'bluish' -> 'blue', 'orangey' -> 'orange', 'creamy'
+    -> 'cream'; None when the word is no such derivation of a colour word."""
+    for suffix in ("ish", "ey", "y"):
+        if word.endswith(suffix) and len(word) > len(suffix) + 2:
+            stem = word[: -len(suffix)]
+            for cand in (stem, stem + "e", stem[:-1] if len(stem) > 3 and stem[-1] == stem[-2] else stem):
+                if _base_lab(cand) is not None:
+                    return cand
+    return None
+
+
+def _modify(lab: F64, light: float, chroma: float) -> F64:
+    L, a, b = (float(v) for v in lab)
+    L = L + (100.0 - L) * light if light >= 0 else L * (1.0 + light)
+    return np.array([L, a * chroma, b * chroma], dtype=np.float64)
+
+
+def color_lab(phrase: str) -> F64 | None:
+    """CIELAB point of a colour as people say it ("reddish", "light grey", "off-white", "navy",
+    "dark wooden", "pale pinkish"), else None. Palette words keep their palette point; modifiers
+    move it (lighter / darker / duller / brighter)."""
+    words = phrase.strip().lower().replace("-coloured", "").replace("-colored", "").split()
+    if not words:
+        return None
+    text = " ".join(words)
+    if text in _WOODS:
+        return np.asarray(LEX_LAB[NAMES.index(_WOODS[text])], dtype=np.float64)
+    base = _base_lab(text)
+    if base is not None:
+        return base
+    head = words[-1]
+    lab = _base_lab(head)
+    if lab is None:
+        stem = _de_ish(head)
+        if stem is None:
+            return None
+        lab = _modify(_base_lab(stem), *_ISH)  # type: ignore[arg-type]
+    for mod in reversed(words[:-1]):
+        m = mod.removesuffix("ish")
+        if m in _MODIFIERS:
+            lab = _modify(lab, *_MODIFIERS[m])
+        else:
+            stem = _de_ish(mod)
+            if stem is None:
+                return None  # "yellow terracotta" is a colour and a material, not one colour
+            lab = 0.75 * lab + 0.25 * _base_lab(stem)  # type: ignore[operator]  # "greenish blue"
+    return lab
+
+
+def is_color_phrase(phrase: str) -> bool:
+    return color_lab(phrase) is not None
+
+
+def color_distance(phrase: str, lab: NDArray[np.floating] | tuple[float, float, float], kL: float = 2.0) -> float:
+    """CIEDE2000 (``kL`` = 2, as for naming) between a spoken colour and a measured colour; raises
+    ``InputError`` for a phrase that names no colour. "purple" vs a pink object is about 20."""
+    target = color_lab(phrase)
+    if target is None:
+        raise InputError(f"unknown colour word {phrase!r}")
+    return float(ciede2000(target, np.asarray(lab, dtype=np.float64), kL=kL))
+
+
 def color_agreement(word: str, lab: NDArray[np.floating] | tuple[float, float, float], scale: float = 12.0,
                     kL: float = 2.0) -> float:
-    """How well a colour word fits a measured colour, in (0, 1]: exp(-ΔE00 / scale)."""
-    name = canonical_color(word)
-    if name is None:
-        raise InputError(f"unknown colour word {word!r}")
-    d = float(ciede2000(LEX_LAB[NAMES.index(name)], np.asarray(lab, dtype=np.float64), kL=kL))
-    return float(np.exp(-d / scale))
+    """How well a colour word or phrase fits a measured colour, in (0, 1]: exp(-ΔE00 / scale)."""
+    return float(np.exp(-color_distance(word, lab, kL=kL) / scale))
