@@ -75,3 +75,115 @@ def test_pipeline_never_imports_the_simulator():
             "print([m for m in sys.modules if m.startswith('capnav.sim')])")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+# -- issue 12: words outside the generator's templates (sentences written for these tests) -----
+
+@pytest.mark.parametrize(("text", "cat"), [
+    ("take me to the loveseat", "sofa"), ("the little cactus on the left", "plant"), ("find the credenza", "cabinet"),
+    ("go to the recliner", "armchair"), ("the chesterfield please", "sofa"), ("the tallboy", "dresser"),
+    ("the wingback armchair", "armchair"), ("the vintage stool", "stool"), ("the scandi-style desk", "desk"),
+])
+def test_wordnet_words_and_unknown_modifiers_keep_the_noun(text, cat):
+    assert parse_instruction(text).category == cat
+
+
+def test_a_category_request_carries_weighted_alternatives():
+    q = parse_instruction("the pink chair in the living room")
+    assert q.category == "chair" and q.room == "living room"
+    assert 0 < q.category_alternatives["stool"] < q.category_alternatives["armchair"] < 1
+    assert {"coffee table", "desk"} <= set(parse_instruction("the round wooden table").category_alternatives)
+
+
+@pytest.mark.parametrize(("text", "colors"), [
+    ("the reddish ottoman", ["reddish"]), ("the whitish sofa", ["whitish"]), ("the off-white armchair", ["cream"]),
+    ("the dark wooden desk", ["dark wooden"]), ("a pale pink lamp", ["pale pink"]),
+    ("the charcoal sofa", ["dark grey"]),
+    ("the mustard-coloured stool", ["mustard"]), ("the greyish-blue bed", []),
+])
+def test_colour_shades(text, colors):
+    q = parse_instruction(text)
+    if colors:
+        assert q.colors == colors
+    assert q.category is not None
+
+
+@pytest.mark.parametrize(("text", "expect"), [
+    ("the lamp closest to the sofa", {"category": "lamp", "anchor_category": "sofa", "proximity": "closest"}),
+    ("the stool farthest from the counter", {"category": "stool", "anchor_category": "counter",
+                                              "proximity": "farthest"}),
+    ("which ottoman is nearest the armchair", {"category": "ottoman", "anchor_category": "armchair"}),
+])
+def test_landmark_relative_superlatives(text, expect):
+    q = parse_instruction(text)
+    assert q.proximity_to_anchor and q.relation is None
+    for k, v in expect.items():
+        assert getattr(q, k) == v
+
+
+def test_closest_to_the_robot_has_no_anchor():
+    q = parse_instruction("the closest lamp to me")
+    assert q.proximity == "closest" and q.anchor_category is None and not q.proximity_to_anchor
+
+
+@pytest.mark.parametrize(("text", "ordinal", "pred"), [
+    ("the third nearest lamp", 3, ("proximity", "closest")), ("the 2nd farthest chair", 2, ("proximity", "farthest")),
+    ("the second largest bed", 2, ("superlative", "largest")),
+])
+def test_ordinals(text, ordinal, pred):
+    q = parse_instruction(text)
+    assert q.ordinal == ordinal and getattr(q, pred[0]) == pred[1]
+
+
+@pytest.mark.parametrize(("text", "cat", "neg"), [
+    ("not the black stool, the other one", "stool", ["black"]), ("the lamp which isn't yellow", "lamp", ["yellow"]),
+    ("the armchair that is not in the bedroom", "armchair", ["bedroom"]),
+    ("any desk except the white one", "desk", ["white"]),
+])
+def test_negations(text, cat, neg):
+    q = parse_instruction(text)
+    assert q.category == cat and q.negations == neg and not set(neg) & set(q.colors)
+
+
+@pytest.mark.parametrize(("text", "cat"), [
+    ("the refrigirator", "refrigerator"), ("the wardobe", "wardrobe"), ("the bookshelff", "bookshelf"),
+    ("the washin machine", "washing machine"),
+])
+def test_typos_in_category_words(text, cat):
+    assert parse_instruction(text).category == cat
+
+
+def test_common_words_are_not_typos():
+    assert parse_instruction("where do I store my shoes").category is None  # not "stove"
+    assert parse_instruction("somewhere I can write").colors == []  # not "white"
+
+
+@pytest.mark.parametrize("text", ["la chaise rose", "la lampe près du canapé", "el sofá blanco", "der Stuhl",
+                                  "vai alla cucina per favore", "ga naar de bank"])
+def test_non_english_is_refused_with_one_message(text):
+    with pytest.raises(InputError, match=r"^instruction is not in English .*only English instructions"):
+        validate_instruction(text)
+
+
+@pytest.mark.parametrize("text", ["the lamp in the den", "go to the sofa por favor", "the chair by Van's desk"])
+def test_one_stray_word_among_english_is_english(text):
+    assert validate_instruction(text) == text
+
+
+@pytest.fixture(scope="module")
+def emb():
+    from capnav.language import create_embedder
+
+    return create_embedder("minilm")
+
+
+@pytest.mark.parametrize(("text", "cats"), [
+    ("somewhere I could sleep for an hour", {"bed", "sofa"}), ("where can I rinse a cup", {"sink"}),
+    ("where do I hang my coat", {"wardrobe"}), ("I would like to keep my juice cold", {"refrigerator"}),
+    ("somewhere comfortable to sit in the lounge", {"armchair", "sofa", "chair", "stool", "ottoman"}),
+])
+def test_requests_by_purpose(text, cats, emb):
+    q = parse_instruction(text, emb)
+    assert q.purpose and q.category in cats, q.to_dict()
+    assert all(0 < w < 1 for w in q.category_alternatives.values())
+    assert parse_instruction(text).category is None  # without an embedder: the purpose, no category

@@ -1,8 +1,19 @@
 """Reading an instruction: validation (empty, too long, not English) and the parts retrieval
-uses: the target category (synonyms and small typos allowed), colour / shape / size words, a
-spatial predicate (closest / farthest, biggest / smallest, next to / near / in front of Y) and a
-room ("in the kitchen"). Parsing is deliberately shallow and predictable; whatever it does not
-understand still reaches the embedding similarity."""
+uses: the target category (WordNet's words for it, small typos allowed) with the other categories
+it may denote, colour / shape / size words (shades as people say them: "reddish", "off-white"),
+a spatial predicate (closest / farthest to the robot or to a landmark, biggest / smallest, next
+to / near / in front of Y, "the second closest"), a room ("in the kitchen", "the kitchen stool"),
+what the target must not be ("not the white one") and, for requests by purpose ("somewhere to
+sit"), the categories that serve it. Parsing is deliberately shallow and predictable; whatever it
+does not understand still reaches the embedding similarity.
+
+Language policy: CapNav understands English only. An instruction with two or more words of another
+language (function words of French, Spanish, German, Italian, Portuguese or Dutch that English
+does not use, or words with letters English does not use), or with one and no English function
+word, is refused with one message: "instruction is not in English (...); only English
+instructions are supported". So "la lampe près du canapé" and "la chaise rose" are refused alike;
+one stray word among English ones ("the lamp in the den", "go to the sofa por favor") is read as
+English, the stray word as an unknown word."""
 
 from __future__ import annotations
 
@@ -10,29 +21,53 @@ import difflib
 import re
 import unicodedata
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from capnav.core.categories import CATEGORIES
 from capnav.core.errors import InputError
-from capnav.language.colors import ALIASES, LEXICON, canonical_color
+from capnav.language.colors import ALIASES, LEXICON, SHADES, canonical_color, color_lab
 from capnav.language.context import ROOM_SYNONYMS
+from capnav.language.lexicon import load_lexicon
+from capnav.language.purpose import find_activity, match_purpose, purpose_categories
+
+if TYPE_CHECKING:
+    from capnav.language.embedder import TextEmbedder
 
 MAX_CHARS = 300
 MAX_WORDS = 50
 
-#: Every surface form of every category (names and synonyms), longest first.
-_FORMS: list[tuple[str, str]] = sorted(((f, c.name) for c in CATEGORIES for f in (c.name, *c.synonyms)),
-                                       key=lambda fc: -len(fc[0]))
-_EXTRA_FORMS = {"couches": "sofa", "sofas": "sofa", "chairs": "chair", "tables": "table", "beds": "bed",
-                "lamps": "lamp", "plants": "plant", "sinks": "sink", "stools": "stool", "desks": "desk",
-                "cabinets": "cabinet", "armchairs": "armchair", "shelves": "bookshelf", "tvs": "tv",
-                "bookshelves": "bookshelf", "ottomans": "ottoman", "dressers": "dresser", "toilets": "toilet",
-                "refrigerators": "refrigerator", "fridges": "refrigerator", "counters": "counter",
-                "stoves": "stove", "nightstands": "nightstand", "wardrobes": "wardrobe", "bathtubs": "bathtub",
-                "sofa bed": "sofa", "settees": "sofa", "coffee tables": "coffee table"}
-_FORM_MAP: dict[str, str] = {**{f: c for f, c in _FORMS}, **_EXTRA_FORMS}
+_LEX = load_lexicon()
+
+
+def _plural(form: str) -> str:
+    *head, last = form.split()
+    if last.endswith("f"):
+        last = last[:-1] + "ves"
+    elif last.endswith(("s", "x", "ch", "sh")):
+        last += "es"
+    elif last.endswith("y") and last[-2:-1] not in "aeiou":
+        last = last[:-1] + "ies"
+    else:
+        last += "s"
+    return " ".join([*head, last])
+
+
+#: Every surface form of every category: WordNet's (the lexicon) and the vocabulary's own names
+#: and synonyms, with plurals.
+_FORM_MAP: dict[str, str] = {}
+for _f, _c in sorted(_LEX.forms.items()):
+    _FORM_MAP.setdefault(_plural(_f), _c)
+_FORM_MAP.update(_LEX.forms)
+for _cat in CATEGORIES:
+    for _f in (_cat.name, *_cat.synonyms):
+        _FORM_MAP[_f] = _cat.name
+        _FORM_MAP.setdefault(_plural(_f), _cat.name)
 _FORM_WORDS = {w for f in _FORM_MAP for w in f.split()}
-_MULTI_FORMS = sorted(f for f in _FORM_MAP if " " in f)
-_SINGLE_FORMS = sorted({f for f in _FORM_MAP if " " not in f and len(f) >= 4})
+#: Typos are matched against the vocabulary's own words only (not WordNet's 600 rarer ones).
+_TYPO_FORMS = {f: c.name for c in CATEGORIES for f0 in (c.name, *c.synonyms) for f in (f0, _plural(f0))}
+_MULTI_FORMS = sorted(f for f in _TYPO_FORMS if " " in f)
+_SINGLE_FORMS = sorted({f for f in _TYPO_FORMS if " " not in f and len(f) >= 4})
+_TYPO_WORDS = {w for f in _TYPO_FORMS for w in f.split()}
 
 _PROXIMITY = {"closest": "closest", "nearest": "closest", "near me": "closest", "closest to me": "closest",
               "farthest": "farthest", "furthest": "farthest", "most distant": "farthest"}
@@ -53,15 +88,11 @@ _FILLER = {"go", "to", "the", "a", "an", "please", "find", "navigate", "take", "
            "one", "of", "is", "which", "i", "want", "need", "get", "bring", "robot", "hey", "and", "with",
            "its", "it", "in", "on", "at", "room", "thanks", "thank", "up", "let", "us", "lets", "visit",
            "approach", "reach", "stop", "ok", "okay", "now", "just", "some", "this"}
-#: Frequent function words of other languages that are not English words.
-_FOREIGN = {"der", "die", "das", "zum", "zur", "und", "bitte", "gehe", "geh", "el", "los", "las", "del", "al",
-            "ve", "ir", "por", "favor", "vers", "le", "les", "du", "des", "aller", "va", "il", "lo", "della",
-            "alla", "vai", "het", "een", "naar", "ga", "och", "till", "og", "til", "na", "ao",
-            "sofá", "weiße", "weißen", "blanco", "blanca", "rojo", "roja", "rouge", "blanc", "canapé", "mesa",
-            "silla", "tisch", "stuhl", "cama", "bett", "cucina", "cocina", "küche"}
 _ENGLISH_HINTS = _FILLER | set(_FORM_MAP) | set(LEXICON) | set(ALIASES) | set(_SIZE_WORDS) | set(_SUPERLATIVE) \
     | {"closest", "nearest", "farthest", "next", "near", "beside", "behind", "front", "kitchen", "bedroom",
        "bathroom", "living", "office", "where", "show", "locate"}
+#: Letters with diacritics that English words do not carry (a word with one is not English).
+_ENGLISH_LETTERS = set("abcdefghijklmnopqrstuvwxyz")
 
 
 @dataclass
@@ -98,7 +129,22 @@ class ParsedQuery:
         return self.category is not None and not self.has_attributes and not self.unknown_words
 
     def to_dict(self) -> dict[str, object]:
-        return {k: v for k, v in self.__dict__.items() if v not in (None, [], "")}
+        return {k: v for k, v in self.__dict__.items() if v not in (None, [], "", {}, False)}
+
+
+def _foreign_words(text: str) -> list[str]:
+    """Words of another language: function words of French, Spanish, German, Italian, Portuguese
+    or Dutch that are not English (from the lexicon), and words with letters English does not use
+    ("canapé", "weiße") unless the lexicon knows them."""
+    out = []
+    for k, w in enumerate(re.findall(r"[^\W\d_]+(?:'[^\W\d_]+)?", text)):
+        low = w.lower()
+        if low in _LEX.foreign:
+            if k == 0 or not w[0].isupper():  # a capitalised word inside a sentence is a name ("Van")
+                out.append(low)
+        elif not set(low) <= _ENGLISH_LETTERS | {"'"} and low not in _FORM_MAP:
+            out.append(low)
+    return out
 
 
 def validate_instruction(text: object) -> str:
@@ -116,12 +162,15 @@ def validate_instruction(text: object) -> str:
         raise InputError("instruction has no words")
     non_latin = sum(1 for ch in letters if not unicodedata.name(ch, "").startswith("LATIN"))
     if non_latin / len(letters) > 0.3:
-        raise InputError("instruction does not look like English (non-Latin script); only English is supported")
-    words = re.findall(r"[^\W\d_]+", t.lower())
-    foreign = sum(w in _FOREIGN for w in words)
-    english = sum(w in _ENGLISH_HINTS for w in words)
-    if foreign >= 2 and foreign > english:
-        raise InputError("instruction does not look like English; only English instructions are supported")
+        raise InputError("instruction is not in English (non-Latin script); only English instructions are "
+                         "supported")
+    foreign = _foreign_words(t)
+    words = re.findall(r"[^\W\d_]+(?:'[^\W\d_]+)?", t.lower())
+    english = [w for w in words if w in _LEX.english]
+    if len(foreign) >= 2 or (foreign and not english):
+        raise InputError(f"instruction is not in English ({', '.join(repr(w) for w in foreign[:4])} "
+                         f"{'is' if len(foreign) == 1 else 'are'} not English); only English instructions are "
+                         "supported")
     return t
 
 
@@ -137,44 +186,64 @@ def _find_category(words: list[str]) -> tuple[str | None, tuple[int, int] | None
         for i in range(len(words) - n + 1):
             near = difflib.get_close_matches(" ".join(words[i:i + n]), _MULTI_FORMS, n=1, cutoff=0.88)
             if near:
-                return _FORM_MAP[near[0]], (i, i + n), True
+                return _TYPO_FORMS[near[0]], (i, i + n), True
     for i in range(len(words)):
         if words[i] in _FORM_MAP:
             return _FORM_MAP[words[i]], (i, i + 1), False
     for i, w in enumerate(words):
-        if len(w) < 4 or w in _FILLER or canonical_color(w) or w in _SHAPES or w in _SIZE_WORDS:
+        if len(w) < 4 or w in _FILLER or canonical_color(w) or w in _SHAPES or w in _SIZE_WORDS \
+                or w in _LEX.not_typos:
             continue
         near = difflib.get_close_matches(w, _SINGLE_FORMS, n=1, cutoff=0.8)
         # A word two or more letters short of a name's start is another word, not a typo ("wash").
         if near and not (near[0].startswith(w) and len(near[0]) - len(w) >= 2):
-            return _FORM_MAP[near[0]], (i, i + 1), True
+            return _TYPO_FORMS[near[0]], (i, i + 1), True
     return None, None, False
+
+
+_COLOR_NOT_ALONE = {"light", "dark", "pale", "deep", "bright", "soft", "rich", "vivid", "dull", "muted", "dusty",
+                    "faded", "pastel"}
+
+
+def _color_name(phrase: str) -> str | None:
+    """The palette name of a colour phrase when it has one ("gray" -> "grey"), else the phrase
+    itself when it names a colour ("reddish", "pale pink", "dark wooden"), else None."""
+    if phrase in _COLOR_NOT_ALONE or phrase in _FORM_MAP:
+        return None
+    name = canonical_color(phrase)
+    if name is not None:
+        return name
+    return phrase if color_lab(phrase) is not None else None
 
 
 def _colors(words: list[str]) -> list[str]:
     out: list[str] = []
     i = 0
     while i < len(words):
-        two = " ".join(words[i:i + 2])
-        c2 = canonical_color(two) if i + 1 < len(words) else None
-        if c2:
-            out.append(c2)
-            i += 2
-            continue
-        c = canonical_color(words[i])
-        if c:
-            out.append(c)
-        i += 1
+        for n in (3, 2, 1):
+            if i + n > len(words):
+                continue
+            gram = " ".join(words[i:i + n]).replace("-coloured", "").replace("-colored", "")
+            if n > 1 and gram in _FORM_MAP:
+                continue
+            c = _color_name(gram)
+            if c:
+                out.append(c)
+                i += n
+                break
+        else:
+            i += 1
     return list(dict.fromkeys(out))
 
 
 #: Words whose typos would hide a predicate or attribute ("bseide" for "beside", "yelow" for "yellow").
 _KEYWORDS = ["beside", "near", "next", "behind", "opposite", "front", "closest", "nearest", "farthest",
              "furthest", "biggest", "largest", "smallest", "kitchen", "bedroom", "bathroom", "living", "office",
-             *sorted(w for w in LEXICON if " " not in w and len(w) >= 5)]
-_COMMON_ADJECTIVES = {"shaped", "l", "coloured", "colored", "color", "colour", "light", "dark", "first", "second",
+             *sorted(w for w in (*LEXICON, *SHADES) if " " not in w and len(w) >= 5)]
+_COMMON_ADJECTIVES = {"shaped", "l", "coloured", "colored", "color", "colour", "first", "second",
                       "third", "fourth", "last", "other", "left", "right", "main", "old", "new", "nice", "same",
-                      "only", "usual", "favourite", "favorite", "pretty", "modern", "classic", "comfy", "comfortable"}
+                      "only", "usual", "favourite", "favorite", "pretty", "modern", "classic", "comfy", "comfortable",
+                      *_COLOR_NOT_ALONE}
 
 
 def _ratio(a: str, b: str) -> float:
@@ -184,55 +253,131 @@ def _ratio(a: str, b: str) -> float:
 def _fix_keyword_typos(words: list[str]) -> list[str]:
     out = []
     for w in words:
-        if len(w) >= 5 and w not in _ENGLISH_HINTS and w not in _FORM_WORDS:
+        if len(w) >= 5 and w not in _ENGLISH_HINTS and w not in _FORM_WORDS and w not in _LEX.not_typos:
             near = difflib.get_close_matches(w, _KEYWORDS, n=1, cutoff=0.8)
             # Only when no category word is at least as close ("bedsde" is "bedside", not "beside").
-            if near and _ratio(w, near[0]) > max((_ratio(w, f) for f in _FORM_WORDS), default=0.0):
+            if near and _ratio(w, near[0]) > max((_ratio(w, f) for f in _TYPO_WORDS), default=0.0):
                 w = near[0]
         out.append(w)
     return out
 
 
-def _is_compound_modifier(word: str, known: set[str]) -> bool:
-    """A word before a category noun that is no colour, material, size, shape or filler word
-    (nor a typo of one) and no category word makes a different object ("pool table")."""
-    if word in known or word in _FORM_WORDS or word in _KEYWORDS or not word.isalpha() or len(word) < 3:
-        return False
-    return not difflib.get_close_matches(word, sorted(known | _FORM_WORDS), n=1, cutoff=0.75)
+_ORDINALS = {"first": 1, "1st": 1, "second": 2, "2nd": 2, "third": 3, "3rd": 3, "fourth": 4, "4th": 4,
+             "fifth": 5, "5th": 5}
+#: "not the white one", "the one that isn't grey", "other than the red one", "except the ...".
+_NEGATION = re.compile(r"(?:\b(?:that|which|who)\s+)?(?:\bis\s+not\b|\bisn't\b|\bisnt\b|\bnot\b|\bother\s+than\b"
+                       r"|\bexcept(?:\s+for)?\b|\bapart\s+from\b|\brather\s+than\b|\binstead\s+of\b)"
+                       r"\s+(?P<neg>[^,;]+?)(?=\s*(?:[,;]|\bbut\b|\bthe\s+other\b|$))")
+#: The robot itself as the reference of closest / farthest.
+_SELF = re.compile(r"^(?:me|you|us|here|yourself|the robot|where i am|where you are|my position|"
+                   r"your position)\b")
+_PROX_WORDS = {"closest": "closest", "nearest": "closest", "farthest": "farthest", "furthest": "farthest",
+               "most distant": "farthest"}
 
 
-def parse_instruction(text: str) -> ParsedQuery:
+def _room_before(words: list[str], start: int) -> tuple[str | None, int]:
+    """A room named just before the target noun ("the kitchen stool"): (room, its first word)."""
+    for n in (2, 1):
+        if start - n >= 0:
+            gram = " ".join(words[start - n:start])
+            if gram in ROOM_SYNONYMS:
+                return ROOM_SYNONYMS[gram], start - n
+    return None, start
+
+
+def _landmark_proximity(q: ParsedQuery, head: str) -> str:
+    """"the chair closest to the kitchen table", "the plant nearest the bathtub", "the armchair
+    farthest from the lamp": an anchor with closest / farthest measured from it. Returns ``head``
+    without the landmark phrase."""
+    words = "|".join(sorted(_PROX_WORDS, key=len, reverse=True))
+    m = re.search(rf"\b(?P<p>{words})\b(?P<mid>(?:\s+\S+)*?)\s*(?:\b(?:to|from|of)\s+|\s+)"
+                  rf"(?:the\s+|a\s+|an\s+|my\s+|our\s+)(?P<anchor>.+)$", head)
+    if not m or _SELF.match(m.group("anchor")):
+        return head
+    anchor_words = m.group("anchor").split()
+    cat, span, _ = _find_category(anchor_words)
+    if cat is None or span is None:
+        return head
+    q.proximity = _PROX_WORDS[m.group("p")]
+    q.proximity_to_anchor = True
+    q.anchor_category = cat
+    q.anchor_phrase = " ".join(anchor_words[: span[1]])
+    return (head[: m.start()] + " " + m.group("mid") + " " + " ".join(anchor_words[span[1]:])).strip()
+
+
+def _negations(q: ParsedQuery, head: str) -> str:
+    """Fill ``q.negations`` with what the target must not be; returns ``head`` without it. The
+    negated phrase's category still names the target ("not the white washer, the other one")."""
+    out = head
+    for m in list(_NEGATION.finditer(head))[::-1]:
+        words = [w for w in m.group("neg").split() if w not in _FILLER and w not in ("other",)]
+        cat, span, _ = _find_category(words)
+        rest = [w for k, w in enumerate(words) if span is None or not span[0] <= k < span[1]]
+        if cat is not None and span is not None:
+            out = out[: m.start()] + " " + " ".join(words[span[0]:span[1]]) + " " + out[m.end():]
+        else:
+            out = out[: m.start()] + " " + out[m.end():]
+        phrase = " ".join(rest).strip()
+        colors = _colors(rest)
+        if colors:
+            q.negations.extend(colors)
+            rest_words = [w for w in rest if w not in " ".join(colors).split()]
+            phrase = " ".join(rest_words).strip()
+        if phrase:
+            q.negations.append(phrase)
+    out = re.sub(r"\bthe\s+other\s+(?:one|of\s+the\s+two)\b", " ", out)
+    return " ".join(out.split())
+
+
+def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
+    """Read ``text``. With ``embedder`` (the retriever's), a request by purpose ("somewhere to
+    sit") is mapped to categories through the lexicon's glosses; without one it keeps ``purpose``
+    and no category."""
     t = validate_instruction(text)
     low = t.lower()
     norm = re.sub(r"[^a-z0-9\-' ]+", " ", low)
+    norm = re.sub(r"\b(\w+)n't\b", r"\1 not", norm.replace("isn't", "is not").replace("isnt", "is not"))
     norm = " ".join(_fix_keyword_typos(norm.replace("'s", "").split()))
     q = ParsedQuery(text=t)
+    head = _negations(q, norm)
     # Room: "in the kitchen", "in the living room".
-    head = norm
     for phrase in sorted(ROOM_SYNONYMS, key=len, reverse=True):
         m = re.search(rf"\b(?:in|inside|within|from|of)\s+(?:the\s+|my\s+|our\s+)?{re.escape(phrase)}\b", head)
         if m:
             q.room = ROOM_SYNONYMS[phrase]
             head = (head[:m.start()] + " " + head[m.end():]).strip()
             break
-    # Proximity (checked before relations so that "closest to me" is not a relation).
-    for phrase in sorted(_PROXIMITY, key=len, reverse=True):
-        if re.search(rf"\b{phrase}\b", head):
-            q.proximity = _PROXIMITY[phrase]
-            head = re.sub(rf"\b{phrase}\b", " ", head)
-            break
-    # Relation: "<target> next to the <anchor>".
-    for rel in _RELATIONS:
-        m = re.search(rf"\b{rel}\s+(?:the\s+|a\s+|an\s+|my\s+)?(.+)$", head)
-        if m and m.start() > 0:
-            anchor_words = m.group(1).split()
-            cat, _, _ = _find_category(anchor_words)
-            if cat is not None:
-                q.relation = "next to" if rel in ("besides", "beside", "by", "close to", "alongside") else rel
-                q.anchor_category = cat
-                q.anchor_phrase = m.group(1)
-                head = head[:m.start()]
+    # Ordinal: "the second closest", "the 3rd biggest".
+    m = re.search(r"\b(first|second|third|fourth|fifth|1st|2nd|3rd|4th|5th)\s+(?=(?:closest|nearest|farthest"
+                  r"|furthest|most distant|biggest|largest|smallest|tiniest|tallest|widest|littlest|narrowest)\b)",
+                  head)
+    if m:
+        q.ordinal = _ORDINALS[m.group(1)]
+        head = (head[:m.start()] + head[m.end():]).strip()
+    # Closest / farthest to a landmark, before relations ("closest to the table" is no "close to").
+    head = _landmark_proximity(q, head)
+    # Proximity to the robot (checked before relations so that "closest to me" is not a relation).
+    if q.proximity is None:
+        for phrase in sorted(_PROXIMITY, key=len, reverse=True):
+            if re.search(rf"\b{phrase}\b", head):
+                q.proximity = _PROXIMITY[phrase]
+                head = re.sub(rf"\b{phrase}\b", " ", head)
                 break
+        head = re.sub(r"\b(?:to|from)\s+(?:me|you|us|here|the robot)\b|\baway\b", " ", head) \
+            if q.proximity else head
+    # Relation: "<target> next to the <anchor>".
+    if q.anchor_category is None:
+        for rel in _RELATIONS:
+            m = re.search(rf"\b{rel}\s+(?:the\s+|a\s+|an\s+|my\s+)?(.+)$", head)
+            if m and m.start() > 0:
+                anchor_words = m.group(1).split()
+                cat, _, _ = _find_category(anchor_words)
+                if cat is not None:
+                    q.relation = "next to" if rel in ("besides", "beside", "by", "close to", "alongside") else rel
+                    q.anchor_category = cat
+                    q.anchor_phrase = m.group(1)
+                    head = head[:m.start()]
+                    break
     words = [w for w in re.split(r"\s+", head.strip()) if w]
     for phrase in sorted(_SUPERLATIVE, key=len, reverse=True):
         if re.search(rf"\b{phrase}\b", head):
@@ -246,18 +391,49 @@ def parse_instruction(text: str) -> ParsedQuery:
     if "l-shaped" in head or "l shaped" in head:
         q.shapes = list(dict.fromkeys([*q.shapes, "L-shaped"]))
     q.materials = [w for w in words if w in _MATERIALS]
-    cat, span, _ = _find_category(words)
+    cat, span, fuzzy = _find_category(words)
+    other = _other_object(words, span)
+    if other is not None:
+        # "pool table", "power plant": WordNet names another object ending in a category word.
+        cat, span = None, None
     q.category = cat
     known = (set(_FILLER) | set(LEXICON) | set(ALIASES) | set(_SHAPES) | set(_SIZE_WORDS) | set(_SUPERLATIVE)
-             | _MATERIALS | _COMMON_ADJECTIVES)
-    if span is not None and span[0] > 0 and _is_compound_modifier(words[span[0] - 1], known):
-        # "pool table", "picnic table": another object whose name ends in a category word.
-        cat, span = None, None
-        q.category = None
+             | _MATERIALS | _COMMON_ADJECTIVES | {w for c in q.colors for w in c.split()}
+             | {w for w in words if re.fullmatch(r"[a-z]+-colou?red", w)})
+    if cat is not None and span is not None:
+        form = " ".join(words[span[0]:span[1]])
+        q.category_alternatives = _LEX.category_alternatives(cat, None if fuzzy else form)
+        if q.room is None:
+            room, start = _room_before(words, span[0])
+            if room is not None:
+                q.room = room
+                words = words[:start] + words[span[0]:]
+                span = (start, start + span[1] - span[0])
     rest = [w for k, w in enumerate(words) if (span is None or not span[0] <= k < span[1]) and w not in known]
     if cat is None:
         q.unknown_words = rest
-    desc = [*q.colors, *q.materials, *q.shapes]
-    noun = cat if cat is not None else " ".join(rest[-2:]) if rest else ""
+        activity = find_activity(head) if other is None else None
+        if activity is not None:
+            q.purpose = activity
+            if embedder is not None:
+                best, alts = purpose_categories(match_purpose(activity, embedder))
+                if best is not None:
+                    q.category, q.category_alternatives, q.unknown_words = best, alts, []
+    else:
+        q.unknown_words = rest
+    desc = list(dict.fromkeys(w for part in (*q.colors, *q.materials, *q.shapes) for w in part.split()))
+    noun = q.category if q.category is not None else " ".join(rest[-2:]) if rest else ""
     q.target_phrase = " ".join([*desc, noun]).strip() or norm
     return q
+
+
+def _other_object(words: list[str], span: tuple[int, int] | None) -> str | None:
+    """A WordNet compound around the category span that names something else ("pool table")."""
+    if span is None:
+        return None
+    for n in (3, 2):
+        for i in range(max(0, span[1] - n), span[0] + 1):
+            gram = " ".join(words[i:i + n])
+            if i + n >= span[1] and gram in _LEX.other:
+                return gram
+    return None

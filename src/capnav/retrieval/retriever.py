@@ -311,7 +311,7 @@ class Retriever:
             xy = np.asarray(robot_xy, dtype=np.float64)
             if xy.shape != (2,) or not np.all(np.isfinite(xy)):
                 raise InputError(f"robot position must be two finite numbers x, y, got {robot_xy!r}")
-        q = instruction if isinstance(instruction, ParsedQuery) else parse_instruction(instruction)
+        q = instruction if isinstance(instruction, ParsedQuery) else parse_instruction(instruction, self.embedder)
         t0 = time.perf_counter()
         e_q = self.embedder.embed([q.text])[0]
         t1 = time.perf_counter()
