@@ -306,25 +306,23 @@ def _landmark_proximity(q: ParsedQuery, head: str) -> str:
 
 
 def _negations(q: ParsedQuery, head: str) -> str:
-    """Fill ``q.negations`` with what the target must not be; returns ``head`` without it. The
-    negated phrase's category still names the target ("not the white washer, the other one")."""
+    """Fill ``q.negations`` with what the target must not be, as short phrases a parse of their own
+    reads ("white", "in the bedroom"); returns ``head`` without them. The negated phrase's category
+    still names the target ("not the white washer, the other one")."""
     out = head
     for m in list(_NEGATION.finditer(head))[::-1]:
-        words = [w for w in m.group("neg").split() if w not in _FILLER and w not in ("other",)]
+        words = m.group("neg").split()
         cat, span, _ = _find_category(words)
-        rest = [w for k, w in enumerate(words) if span is None or not span[0] <= k < span[1]]
         if cat is not None and span is not None:
             out = out[: m.start()] + " " + " ".join(words[span[0]:span[1]]) + " " + out[m.end():]
+            words = words[:span[0]] + words[span[1]:]
         else:
             out = out[: m.start()] + " " + out[m.end():]
-        phrase = " ".join(rest).strip()
-        colors = _colors(rest)
-        if colors:
-            q.negations.extend(colors)
-            rest_words = [w for w in rest if w not in " ".join(colors).split()]
-            phrase = " ".join(rest_words).strip()
-        if phrase:
-            q.negations.append(phrase)
+        while words and words[0] in ("the", "a", "an", "one", "other", "that", "which", "is", "are", "be"):
+            words = words[1:]
+        words = [w for w in words if w not in ("one", "ones", "other")]
+        if words:
+            q.negations.append(" ".join(words))
     out = re.sub(r"\bthe\s+other\s+(?:one|of\s+the\s+two)\b", " ", out)
     return " ".join(out.split())
 
