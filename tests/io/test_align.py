@@ -168,3 +168,25 @@ def test_rotation_between_opposites() -> None:
         for s in (1.0, -1.0):
             R = rotation_between(a, s * np.array([0.0, 0.0, 1.0]))
             assert np.allclose(R @ a, s * np.array([0.0, 0.0, 1.0])) and np.isclose(np.linalg.det(R), 1.0)
+
+
+def test_named_axis_leaving_the_world_on_its_side() -> None:
+    """Cameras looking straight down (the depth cannot tell up by itself) over a floor with a third
+    of the points scattered under it: a named +z is refused, naming the cue that fails."""
+    from capnav.io.align import named_floor
+
+    rng = np.random.default_rng(1)
+    floor = np.c_[rng.uniform(-2, 2, (3000, 2)), np.zeros(3000)]
+    under = np.c_[rng.uniform(-2, 2, (1500, 2)), rng.uniform(-2.0, -0.3, 1500)]
+    N = np.vstack([np.tile([0.0, 0.0, 1.0], (3000, 1)), np.full((1500, 3), np.nan)])
+    poses = np.tile(np.eye(4), (6, 1, 1))
+    poses[:, :3, :3] = np.diag([1.0, -1.0, -1.0])
+    poses[:, :3, 3] = np.c_[np.linspace(-1, 1, 6), np.zeros(6), np.full(6, 1.2)]
+    cfg = UpConfig()
+    res = choose_up(np.vstack([floor, under]), N, poses, cfg)
+    assert not res.ok  # no confident auto choice to contradict: the named axis is judged on its own
+    with pytest.raises(InputError, match=r"with --up \+z the world would be on its side: .* fails on below "
+                                         r"\(33% of the depth points lie below that floor\)"):
+        named_floor(res, np.array([0.0, 0.0, 1.0]), "+z", cfg)
+    clean = choose_up(floor, N[:3000], poses, cfg)
+    assert named_floor(clean, np.array([0.0, 0.0, 1.0]), "+z", cfg).up[2] > 0.999  # the same floor, nothing under

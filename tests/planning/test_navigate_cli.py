@@ -36,6 +36,7 @@ def test_navigate_writes_picture_and_json(small_map, tmp_path) -> None:
     assert res.exit_code in (0, 1), res.output
     rec = json.loads((tmp_path / "navigate.json").read_text())
     assert (tmp_path / "navigate.png").stat().st_size > 10_000
+    assert (tmp_path / "navigate_map.yaml").is_file() and (tmp_path / "navigate_map.pgm").is_file()
     assert rec["instruction"] == f"go to {words}" and rec["occupancy"] == "truth"
     chosen = rec["retrieval"]["chosen"]
     assert chosen is not None and rec["chosen_id"] == chosen["id"]

@@ -98,7 +98,7 @@ def floor_alignment(views: Iterable[tuple[NDArray[np.floating], NDArray[np.float
                              "or --up none to keep the recorded frame")
         c = res.chosen
     else:
-        c = _named(res, u, up, cfg)
+        c = named_floor(res, u, up, cfg)
     A = np.eye(4)
     A[:3, :3] = rotation_between(c.up, np.array([0.0, 0.0, 1.0]))
     A[2, 3] = -c.offset  # the plane n.p = offset becomes z = offset after the rotation
@@ -112,7 +112,7 @@ def floor_alignment(views: Iterable[tuple[NDArray[np.floating], NDArray[np.float
                              "facts": {k: round(v, 4) for k, v in c.facts.items()}, "search": res.to_meta()})
 
 
-def _named(res: UpResult, u: NDArray[np.float64], up: str, cfg: UpConfig) -> UpCandidate:
+def named_floor(res: UpResult, u: NDArray[np.float64], up: str, cfg: UpConfig) -> UpCandidate:
     """The floor for a user-named up axis, or a refusal that says what the depth shows instead."""
     found = f"the depth says up is {res.chosen.describe()} (confidence {res.confidence:.2f})" if res.chosen else ""
     if res.ok and res.chosen is not None and angle_deg(res.chosen.up, u) > cfg.max_tilt_deg:
