@@ -38,3 +38,15 @@ class ModelError(CapNavError):
 
 class NotFoundError(CapNavError):
     """A query matched nothing above threshold, or a goal is unreachable."""
+
+
+class OutputError(InputError):
+    """An output path cannot be written (unwritable folder, a folder where a file is meant, ...)."""
+
+
+class SystemIOError(CapNavError):
+    """The operating system refused a read or write; the message names the path and the reason."""
+
+
+class Interrupted(CapNavError):
+    """The user pressed Ctrl-C; the message says what was interrupted and what was kept."""

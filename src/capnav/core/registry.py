@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable
 from typing import Any, Generic, TypeVar
 
@@ -33,13 +34,26 @@ class Registry(Generic[T]):
     def names(self) -> list[str]:
         return sorted(self._factories)
 
-    def create(self, name: str, **kwargs: Any) -> T:
+    def _factory(self, name: str) -> Callable[..., T]:
         try:
-            factory = self._factories[name]
+            return self._factories[name]
         except KeyError:
             raise InputError(
                 f"unknown {self.kind} backend {name!r}; available: {', '.join(self.names()) or 'none'}"
             ) from None
+
+    def required(self, name: str) -> list[str]:
+        """The settings backend ``name`` cannot do without (e.g. ``path`` of a local model folder)."""
+        sig = inspect.signature(self._factory(name))
+        return [p.name for p in sig.parameters.values() if p.default is inspect.Parameter.empty
+                and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+
+    def create(self, name: str, **kwargs: Any) -> T:
+        factory = self._factory(name)
+        missing = [k for k in self.required(name) if k not in kwargs]
+        if missing:  # say so, instead of a TypeError from deep inside the backend
+            what = " and ".join("a local model folder (path)" if k == "path" else k for k in missing)
+            raise InputError(f"{self.kind} backend {name!r} needs {what}")
         return factory(**kwargs)
 
     def __contains__(self, name: object) -> bool:

@@ -61,5 +61,5 @@ class HFLocalVLM:
 
 
 @VLMS.register("hf-local")
-def hf_local(**kwargs: Any) -> HFLocalVLM:
-    return HFLocalVLM(**kwargs)
+def hf_local(path: str | os.PathLike[str], **kwargs: Any) -> HFLocalVLM:
+    return HFLocalVLM(path, **kwargs)
