@@ -87,8 +87,10 @@ def test_wrong_size_frame_and_bad_pose_are_named(tmp_path: Path) -> None:
     vals[2] = "-1.0"  # breaks the rotation's orthonormality
     lines[2] = " ".join(vals)
     (tmp_path / "ds" / "poses.txt").write_text("\n".join(lines) + "\n")
-    with pytest.raises(PoseError, match="frame 2"):
-        DatasetReader(tmp_path / "ds")
+    r = DatasetReader(tmp_path / "ds")  # one bad pose costs its frame, not the dataset
+    with pytest.raises(DatasetError, match=r"frame 2: .*line 3: rotation is not orthonormal"):
+        r.frame(2)
+    assert r.frame(0).index == 0 and list(r.bad_poses) == [2]
 
 
 def test_incomplete_and_malformed_datasets(tmp_path: Path) -> None:

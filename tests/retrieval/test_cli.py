@@ -35,7 +35,7 @@ def test_caption_then_query(map_file: Path, tmp_path: Path):
     r = runner.invoke(app, ["query", str(out), "closest chair", "--robot", "oops"])
     assert r.exit_code != 0 and "X,Y" in str(r.exception)
     r = runner.invoke(app, ["query", str(out), "the piano"])
-    assert r.exit_code == 0 and "not found" in r.stdout
+    assert r.exit_code == 1 and "not found" in r.stdout  # answered "not found": exit code 1
 
 
 def test_mismatched_embedder_is_refused(map_file: Path, tmp_path: Path):

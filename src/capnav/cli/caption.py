@@ -6,6 +6,14 @@ from pathlib import Path
 
 import typer
 
+from capnav.cli.options import (
+    check_input_path,
+    check_map_matches_dataset,
+    check_model_folder,
+    check_output_file,
+    on_interrupt,
+)
+
 
 def register(app: typer.Typer) -> None:
     @app.command("caption")
@@ -28,7 +36,18 @@ def register(app: typer.Typer) -> None:
 
         from capnav.io.mapfile import load_map, save_map
         from capnav.language import create_captioner, create_embedder, describe_map
+        from capnav.language.embedder import EMBEDDERS
+        from capnav.language.vlm.base import _MODULES, VLMS
 
+        check_input_path(map_path, "map file")
+        out = output or map_path
+        check_output_file(out, "-o" if output is not None else "MAP")
+        check_model_folder("--embedder", embedder, embedder_path, "--embedder-path", EMBEDDERS.required(embedder))
+        if captioner in _MODULES:
+            import importlib
+
+            importlib.import_module(f"capnav.language.vlm.{_MODULES[captioner]}")
+            check_model_folder("--captioner", captioner, model_path, "--model-path", VLMS.required(captioner))
         kw: dict[str, object] = {}
         if model:
             kw["model"] = model
@@ -44,8 +63,10 @@ def register(app: typer.Typer) -> None:
             from capnav.io.dataset import DatasetReader
 
             reader = DatasetReader(dataset)
+            check_map_matches_dataset(cmap.meta, map_path, dataset, reader)
+        on_interrupt(f"{out} was not written (it is as it was); captions made so far are lost unless the "
+                     "captioner caches them")
         rep = describe_map(cmap, reader, cap, emb, progress=progress, reselect_views=reselect_views)
-        out = output or map_path
         save_map(cmap, out)
         con = Console(stderr=True)
         con.print(f"{out}: {rep.objects} objects, {rep.captions_new} new captions, {rep.captions_cached} cached, "

@@ -9,27 +9,30 @@ from typing import Annotated
 
 import typer
 
+from capnav.cli.options import Height, MaxFrames, Seed, Width, check_output_dir, on_interrupt
+
 
 def register(app: typer.Typer) -> None:
     @app.command("eval")
     def eval_(
-        scenes: Annotated[int, typer.Option(help="number of apartments (the paper: 10)")] = 10,
-        episodes_per_scene: Annotated[int, typer.Option(help="episodes per apartment and protocol")] = 9,
-        seed: Annotated[int, typer.Option(help="run seed: apartments, episodes, detector noise")] = 0,
+        scenes: Annotated[int, typer.Option(min=1, help="number of apartments (the paper: 10)")] = 10,
+        episodes_per_scene: Annotated[int, typer.Option(min=1, help="episodes per apartment and protocol")] = 9,
+        seed: Seed = 0,
         methods: Annotated[str, typer.Option(help="comma-separated method names, or 'all' (every registered one)")
                            ] = "all",
         protocols: Annotated[str, typer.Option(help="comma-separated: label, description")] = "label,description",
-        workers: Annotated[int, typer.Option(help="local worker processes (one apartment per task)")] = 2,
+        workers: Annotated[int, typer.Option(min=1, help="local worker processes (one apartment per task)")] = 2,
         out: Annotated[Path, typer.Option("--out", "-o", help="run folder")] = Path("runs/eval"),
         ray: Annotated[str | None, typer.Option(
             "--ray", help="run the apartments on a Ray cluster at this address ('local' starts one)")] = None,
         episodes: Annotated[Path | None, typer.Option(
             help="folder with <protocol>.json episode files of an earlier run, to rerun exactly")] = None,
-        width: Annotated[int, typer.Option(help="camera width (pixels)")] = 320,
-        height: Annotated[int, typer.Option(help="camera height (pixels)")] = 240,
-        max_frames: Annotated[int | None, typer.Option(help="use at most this many exploration frames")] = None,
-        pictures: Annotated[int, typer.Option(help="failure pictures per method, protocol and apartment")] = 1,
-        max_steps: Annotated[int, typer.Option(help="action budget per subgoal of the exploring methods")] = 200,
+        width: Width = 320,
+        height: Height = 240,
+        max_frames: MaxFrames = None,
+        pictures: Annotated[int, typer.Option(min=0, help="failure pictures per method, protocol and apartment")] = 1,
+        max_steps: Annotated[int, typer.Option(min=1, help="action budget per subgoal of the exploring methods")
+                             ] = 200,
         progress: Annotated[bool, typer.Option(help="show progress")] = True,
     ) -> None:
         """Run every method on the same apartments, maps and episodes; write results.json and report.md."""
@@ -45,9 +48,12 @@ def register(app: typer.Typer) -> None:
             names = DEFAULT_METHODS + tuple(m for m in load_methods() if m not in DEFAULT_METHODS)
         else:
             names = tuple(m.strip() for m in methods.split(",") if m.strip())
+        check_output_dir(out, "--out")  # a run folder may exist: finished apartments are reused
         cfg = EvalConfig(scenes=scenes, episodes_per_scene=episodes_per_scene, seed=seed, methods=names,
                          protocols=tuple(parse_protocols(protocols)), pictures_per_scene=pictures, max_steps=max_steps,
                          pipeline=PipelineConfig(width=width, height=height, max_frames=max_frames))
+        on_interrupt(f"workers stopped; finished apartments are kept in {out}/scenes (run the same command "
+                     "again to resume from them)")
         res = run_benchmark(cfg, out, workers=workers, ray_address=ray, episodes_dir=episodes, progress=progress,
                             command=" ".join(["capnav", *map(shlex.quote, sys.argv[1:])]))
         con = Console()

@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import json
 import re
+import time
 from pathlib import Path
 from typing import Any
 
 import typer
+
+from capnav.cli.options import MaxFrames, Seed, check_output_file, on_interrupt
 
 
 def parse_detector_options(items: list[str]) -> dict[str, Any]:
@@ -38,7 +41,7 @@ def register(app: typer.Typer) -> None:
                                                  "or centernet (COCO-80 on real pixels, CPU; capnav models install), "
                                                  "owl (OWL-ViT / OWLv2 from a local folder); docs/perception.md"),
         noise: str = typer.Option("default", help="sim detector noise: default, hard, oracle"),
-        seed: int = typer.Option(0, help="seed of the sim detector's noise"),
+        seed: Seed = 0,
         detector_option: list[str] = typer.Option(
             [], "--detector-option", metavar="KEY=VALUE",
             help="detector setting passed to the backend, repeatable; VALUE is JSON when it parses, else "
@@ -46,7 +49,7 @@ def register(app: typer.Typer) -> None:
                  "model_path=DIR, mask=depth|sam|box, ...)"),
         encoder: str = typer.Option("label-embedding", help="dense feature encoder backend"),
         embedder: str = typer.Option("minilm", help="text embedder of the label-embedding encoder"),
-        max_frames: int | None = typer.Option(None, help="use only the first N frames"),
+        max_frames: MaxFrames = None,
         strict: bool = typer.Option(False, help="stop at the first bad frame instead of skipping it"),
         progress: bool = typer.Option(True, help="show a progress bar"),
     ) -> None:
@@ -60,8 +63,9 @@ def register(app: typer.Typer) -> None:
         from capnav.mapping import MapperConfig, map_dataset
         from capnav.perception import create_detector, create_encoder
 
+        check_output_file(output, "-o")  # fail on an unwritable output and a bad folder before any model loads
         options = parse_detector_options(detector_option)
-        reader = DatasetReader(dataset)  # fail on a bad folder before loading any model
+        reader = DatasetReader(dataset)
         kwargs = {"noise": noise, "seed": seed, **options} if detector == "sim" else options
         try:
             det = create_detector(detector, **kwargs)
@@ -69,11 +73,14 @@ def register(app: typer.Typer) -> None:
             raise InputError(f"detector {detector!r} rejected its options {sorted(options)}: {e}") from None
         enc = create_encoder(encoder, embedder=create_embedder(embedder))
         cfg = MapperConfig(on_bad_frame="raise" if strict else "skip")
+        on_interrupt(f"no map was written ({output} is as it was)")
+        t0 = time.perf_counter()
         cmap = map_dataset(reader, det, enc, cfg, max_frames=max_frames, progress=progress)
+        seconds = time.perf_counter() - t0
         save_map(cmap, output)
         con = Console(stderr=True)
         m = cmap.meta
-        speed = f" ({m['frames_used'] / m['mapping_seconds']:.1f} frames/s)" if m["mapping_seconds"] else ""
+        speed = f" ({m['frames_used'] / seconds:.1f} frames/s)" if seconds > 0 and m["frames_used"] else ""
         con.print(f"{output}: {len(cmap.objects)} objects, {len(cmap.voxels)} voxels, "
                   f"{m['frames_used']} frames{speed}, detector {det.id}")
         for reason, frames in _grouped(m["frames_skipped"]):

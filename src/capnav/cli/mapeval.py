@@ -21,14 +21,30 @@ def register(app: typer.Typer) -> None:
         from rich.console import Console
         from rich.table import Table
 
+        from capnav.cli.options import check_map_scene, check_output_file
         from capnav.core.atomic import write_json
         from capnav.io.mapfile import load_map
         from capnav.mapping.quality import evaluate_map, truth_for_dataset
         from capnav.sim.manifest import SceneManifest
 
+        if json_out is not None:
+            check_output_file(json_out, "--json")
         cmap = load_map(map_file)
         man = SceneManifest.load(manifest)
-        seen, occ, note = truth_for_dataset(dataset or manifest.parent, man)
+        check_map_scene(cmap.meta, map_file, man.seed, f"--manifest {manifest}")
+        data = dataset or manifest.parent
+        if dataset is not None or (data / "meta.json").exists():
+            from capnav.cli.options import check_map_matches_dataset
+            from capnav.core.errors import CapNavError
+            from capnav.io.dataset import DatasetReader
+
+            try:
+                reader = DatasetReader(data)
+            except CapNavError:
+                reader = None  # truth_for_dataset says what is missing
+            if reader is not None:
+                check_map_matches_dataset(cmap.meta, map_file, data, reader)
+        seen, occ, note = truth_for_dataset(data, man)
         q = evaluate_map(cmap, man, seen, occ)
         table = Table(title=f"mapping quality: {map_file.name} (scene seed {man.seed})")
         for col in ("metric", "value", "target"):

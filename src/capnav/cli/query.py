@@ -33,14 +33,19 @@ def register(app: typer.Typer) -> None:
         embedder: str = typer.Option("auto", help="auto (the map's default model) or a backend name"),
         embedder_path: Path | None = typer.Option(None, help="local model folder for non-default embedders"),
     ) -> None:
-        """Retrieve the object an instruction describes (paper 3.4)."""
+        """Retrieve the object an instruction describes (paper 3.4); exit code 1 when nothing matches."""
+        from capnav.cli.options import check_model_folder, check_verifier
         from capnav.io.mapfile import load_map
         from capnav.language import create_embedder
+        from capnav.language.embedder import EMBEDDERS
         from capnav.language.onnx_embedder import MINILM_MODEL_ID
         from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
         from capnav.retrieval.result import QueryResult
 
         xy = parse_xy(robot)
+        check_verifier(verifier)
+        if embedder != "auto":
+            check_model_folder("--embedder", embedder, embedder_path, "--embedder-path", EMBEDDERS.required(embedder))
         cmap = load_map(map_path)
         if embedder == "auto":
             models = {o.embedding_model for o in cmap.objects if o.embedding_model}
@@ -57,8 +62,10 @@ def register(app: typer.Typer) -> None:
         res: QueryResult = Retriever(cmap, emb, create_verifier(verifier), cfg).query(instruction, robot_xy=xy)
         if as_json:
             typer.echo(json.dumps(res.to_dict(), indent=2))
-            return
-        _print(res)
+        else:
+            _print(res)
+        if res.chosen is None:  # answered "not found": exit code 1, as `capnav navigate` when not reached
+            raise typer.Exit(1)
 
 
 def _print(res: object) -> None:

@@ -18,6 +18,7 @@ from rich.console import Console
 
 from capnav.core.atomic import write_bytes, write_json
 from capnav.core.errors import CapNavError, InputError
+from capnav.core.limits import check_count, check_image_size
 from capnav.demo.report import Report, ReportItem, verdict, write_html, write_markdown
 from capnav.eval.pipeline import PipelineConfig, open_scene
 from capnav.eval.success import SUCCESS_RADIUS_M, distance_to_instances
@@ -45,8 +46,8 @@ class DemoConfig:
     def __post_init__(self) -> None:
         if self.seed < 0:
             raise InputError(f"seed must be >= 0, got {self.seed}")
-        if not (32 <= self.width <= 1920 and 24 <= self.height <= 1440):
-            raise InputError(f"image size {self.width}x{self.height} is outside 32x24 .. 1920x1440")
+        check_image_size(self.width, self.height)
+        check_count("max_frames", self.max_frames, optional=True)
 
 
 @dataclass

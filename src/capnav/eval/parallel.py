@@ -36,7 +36,10 @@ def run_tasks(fn: Callable[[T], R], tasks: Sequence[T], workers: int = 1, ray_ad
     # spawn, not fork: pybullet, onnxruntime and numba threads do not survive a fork cleanly.
     ctx = multiprocessing.get_context("spawn")
     results: dict[int, R] = {}
-    with ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=ctx) as pool:
+    # Workers ignore Ctrl-C: the parent alone decides, and stops them at once (_stop) instead of
+    # waiting for every running apartment to finish; finished ones have written their results.
+    pool = ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=ctx, initializer=_ignore_sigint)
+    try:
         futures: dict[Future[R], int] = {pool.submit(fn, t): i for i, t in enumerate(tasks)}
         pending = set(futures)
         for _ in track(range(len(tasks)), description, enabled=progress):
@@ -45,7 +48,28 @@ def run_tasks(fn: Callable[[T], R], tasks: Sequence[T], workers: int = 1, ray_ad
                 results[futures[f]] = f.result()
             if not pending:
                 break
+    except BaseException:
+        _stop(pool)
+        raise
+    pool.shutdown()
     return [results[i] for i in range(len(tasks))]
+
+
+def _ignore_sigint() -> None:
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """Terminate the workers now (an error or Ctrl-C must not wait for running tasks)."""
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    for p in procs:
+        if p.is_alive():
+            p.terminate()
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in procs:
+        p.join(timeout=1.0)
 
 
 def _run_ray(fn: Callable[[T], R], tasks: Sequence[T], address: str, progress: bool, description: str) -> list[R]:

@@ -18,6 +18,8 @@ from typing import Any
 import numpy as np
 
 from capnav.core.atomic import write_json
+from capnav.core.errors import InputError
+from capnav.core.limits import check_count, check_seed
 from capnav.eval.episode_runner import run_episode
 from capnav.eval.episodes import PROTOCOLS, Episode, check_against_manifest
 from capnav.eval.generate import EpisodeConfig, description_episodes, label_episodes
@@ -49,6 +51,14 @@ class EvalConfig:
     max_steps: int = 200
     pictures_per_scene: int = 1  # failure pictures per (method, protocol) and apartment
     method_options: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for name in ("scenes", "episodes_per_scene", "subgoals", "max_steps"):
+            check_count(name, getattr(self, name))
+        check_count("max_frames", self.pipeline.max_frames, optional=True)
+        check_seed("seed", self.seed)
+        if self.pictures_per_scene < 0:
+            raise InputError(f"pictures_per_scene must be >= 0, got {self.pictures_per_scene}")
 
     def scene_seeds(self) -> list[int]:
         """Apartment seeds of this run: ``1000 * seed + i`` (seed 0: apartments 0..9)."""

@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from PIL import Image
 
 from capnav.core.atomic import write_bytes, write_json, write_text
-from capnav.core.errors import DatasetError, FrameError
+from capnav.core.errors import DatasetError, FrameError, PoseError
 from capnav.core.frame import Frame
 from capnav.core.geometry import Intrinsics, check_pose
 from capnav.core.jsonfile import read_json_object
@@ -57,6 +57,18 @@ def _clear(path: Path) -> None:
         shutil.rmtree(path / sub, ignore_errors=True)
     for name in ("meta.json", "intrinsics.json", "poses.txt", "manifest.json", "topdown.png"):
         (path / name).unlink(missing_ok=True)
+
+
+def check_dataset_target(out: Path, overwrite: bool) -> None:
+    """``out`` may become a dataset folder: absent, empty, or (with ``overwrite``) a dataset already;
+    a folder holding anything else is never replaced."""
+    if out.exists() and not out.is_dir():
+        raise DatasetError(f"{out} exists and is not a folder")
+    if out.is_dir() and any(out.iterdir()):
+        if not overwrite:
+            raise DatasetError(f"{out} is not empty (pass --overwrite to replace it)")
+        if not (out / "meta.json").exists() or not (out / "poses.txt").exists():
+            raise DatasetError(f"{out} is not a capnav-rgbd dataset folder; refusing to replace it")
 
 
 class DatasetWriter:
@@ -161,8 +173,8 @@ class DatasetReader:
             raise DatasetError(f"{self.path}: dataset format version {self.meta.get('version')} is not supported "
                                f"(expected {FORMAT_VERSION})")
         if not self.meta.get("complete", False) and not allow_incomplete:
-            raise DatasetError(f"{self.path}: dataset is incomplete (its writer did not finish); "
-                               "pass allow_incomplete=True to read the frames written so far")
+            raise DatasetError(f"{self.path}: dataset is incomplete (its writer did not finish or was "
+                               "interrupted); write it again (capnav sim / capnav import --overwrite)")
         k = self._json("intrinsics.json")
         try:
             self.intrinsics = Intrinsics(float(k["fx"]), float(k["fy"]), float(k["cx"]), float(k["cy"]),
@@ -171,6 +183,7 @@ class DatasetReader:
             raise DatasetError(f"{self.path}/intrinsics.json is malformed: {e}") from None
         self.depth_scale = float(self.meta.get("depth_scale", DEPTH_SCALE))
         self.has_gt = bool(self.meta.get("has_gt", False))
+        self.bad_poses: dict[int, str] = {}  # frame -> why its pose is unusable (that frame raises)
         self.timestamps, self.poses = self._poses()
         n = int(self.meta.get("num_frames", len(self.poses)))
         if self.meta.get("complete", False) and n != len(self.poses):
@@ -196,10 +209,28 @@ class DatasetReader:
             if len(vals) != 18 or int(vals[0]) != len(poses):
                 raise DatasetFrameError(ln, f"{p} line {ln + 1}: expected 'index timestamp' + 16 pose values "
                                             f"for frame {len(poses)}")
-            T = check_pose(np.array(vals[2:]).reshape(4, 4), frame=len(poses))
+            try:
+                T = check_pose(np.array(vals[2:]).reshape(4, 4), frame=len(poses))
+            except PoseError as e:  # one bad pose costs its frame (skipped by the mapper), not the dataset
+                self.bad_poses[len(poses)] = f"{p} line {ln + 1}: {e.reason}"
+                T = np.full((4, 4), np.nan)
             ts.append(vals[1])
             poses.append(T)
         return np.asarray(ts, dtype=np.float64), np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)
+
+    def fingerprint(self) -> str:
+        """What identifies this recording (camera, trajectory, producer), so a map can name the dataset
+        it was made from and a later command can tell another apartment's dataset from it."""
+        import hashlib
+
+        h = hashlib.sha256()
+        for name in ("intrinsics.json", "poses.txt"):
+            try:
+                h.update((self.path / name).read_bytes())
+            except OSError as e:
+                raise DatasetError(f"{self.path}/{name} is unreadable ({e.strerror or e})") from None
+        h.update(json.dumps(self.meta.get("meta") or {}, sort_keys=True).encode("utf-8"))
+        return h.hexdigest()[:16]
 
     @property
     def manifest_path(self) -> Path | None:
@@ -229,6 +260,8 @@ class DatasetReader:
     def frame(self, i: int) -> Frame:
         if not (0 <= i < len(self)):
             raise DatasetError(f"{self.path}: frame {i} out of range (dataset has {len(self)} frames)")
+        if i in self.bad_poses:
+            raise DatasetFrameError(i, self.bad_poses[i])
         rgb = self._image("rgb", i, "RGB").astype(np.uint8)
         depth = self._image("depth", i, "I;16").astype(np.float32) / np.float32(self.depth_scale)
         gi = gc = None

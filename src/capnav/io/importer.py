@@ -7,8 +7,6 @@ folder and renamed into place only once complete, so an interrupted import leave
 
 from __future__ import annotations
 
-import os
-import shutil
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -18,7 +16,8 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from capnav.core.errors import DatasetError, InputError
+from capnav.core.atomic import atomic_dir
+from capnav.core.errors import InputError
 from capnav.core.frame import Frame
 from capnav.core.geometry import Intrinsics
 from capnav.core.progress import track
@@ -98,25 +97,15 @@ def select(frames: list[PlannedFrame], stride: int = 1, max_frames: int | None =
     return frames[::stride][:max_frames]
 
 
-def _check_target(out: Path, overwrite: bool) -> None:
-    if out.exists() and not out.is_dir():
-        raise DatasetError(f"{out} exists and is not a folder")
-    if out.is_dir() and any(out.iterdir()):
-        if not overwrite:
-            raise DatasetError(f"{out} is not empty (pass --overwrite to replace it)")
-        if not (out / "meta.json").exists() or not (out / "poses.txt").exists():
-            raise DatasetError(f"{out} is not a capnav-rgbd dataset folder; refusing to replace it")
-
-
 def import_recording(rec: Recording, out: str | Path, up: str = "auto", stride: int = 1,
                      max_frames: int | None = None, overwrite: bool = False, progress: bool = True,
                      align_frames: int = 30, floor: UpConfig | None = None) -> ImportReport:
     """Write ``rec`` as a ``capnav-rgbd`` folder at ``out`` with every pose aligned (``T_wc' = A @ T_wc``)."""
-    from capnav.io.dataset import DatasetWriter
+    from capnav.io.dataset import DatasetWriter, check_dataset_target
 
     t0 = time.monotonic()
     out = Path(out)
-    _check_target(out, overwrite)
+    check_dataset_target(out, overwrite)
     frames = select(rec.frames, stride, max_frames)
     if not frames:
         counts = ", ".join(f"{n} {r}" for r, n in rec.skipped.counts().items()) or "none in the recording"
@@ -127,11 +116,9 @@ def import_recording(rec: Recording, out: str | Path, up: str = "auto", stride: 
     align = floor_alignment(views, rec.K, up, floor, poses=np.stack([f.T_wc for f in frames]))
 
     skipped = SkipLog(list(rec.skipped.skips))
-    tmp = out.parent / f".{out.name}.importing-{os.getpid()}"
-    shutil.rmtree(tmp, ignore_errors=True)
     meta: dict[str, Any] = {"source": rec.kind, "recording": str(rec.path), **rec.meta,
                             "alignment": align.to_meta()}
-    try:
+    with atomic_dir(out, overwrite=True) as tmp:  # the target was checked above
         w = DatasetWriter(tmp, rec.K, meta, write_gt=False)
         for f, rgb, depth in track(rec.load(frames), f"importing {rec.path.name}", total=len(frames),
                                    enabled=progress):
@@ -152,21 +139,7 @@ def import_recording(rec: Recording, out: str | Path, up: str = "auto", stride: 
                             "skipped": skipped.counts(),
                             "skipped_examples": {r: [s.name for s in skipped.examples(r)] for r in skipped.counts()}}
         w.close()
-        _move_into_place(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     return ImportReport(out, rec.kind, len(rec.frames), len(frames), w.meta["import"]["written"], skipped, align,
                         time.monotonic() - t0, meta)
 
 
-def _move_into_place(tmp: Path, out: Path) -> None:
-    """Rename the finished folder to ``out``; a previous dataset there is removed only afterwards."""
-    old = None
-    if out.exists():
-        old = out.parent / f".{out.name}.replaced-{os.getpid()}"
-        shutil.rmtree(old, ignore_errors=True)
-        os.replace(out, old)
-    os.replace(tmp, out)
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)

@@ -276,4 +276,28 @@ def _decode(r: _Reader, header: dict[str, Any]) -> CapNavMap:
     traj = None
     if "trajectory/poses.npy" in r.entries:
         traj = CameraTrajectory(r.array("trajectory/frames.npy"), r.array("trajectory/poses.npy"))
-    return CapNavMap(objects=objects, voxels=voxels, occupancy=occ, meta=meta, caches=caches, trajectory=traj)
+    cmap = CapNavMap(objects=objects, voxels=voxels, occupancy=occ, meta=meta, caches=caches, trajectory=traj)
+    _check_finite(r, cmap)
+    return cmap
+
+
+def _check_finite(r: _Reader, cmap: CapNavMap) -> None:
+    """Checksums prove the bytes are the ones written, not that they make sense: a NaN position or
+    voxel would reach the planner's integer grid maths. Every float array must be finite."""
+    for o in cmap.objects:
+        for name in _ARRAY_DTYPES:
+            a = getattr(o, name)
+            if a is not None and np.asarray(a).dtype.kind == "f" and not np.isfinite(a).all():
+                raise r.fail(f"object {o.id}: {name} holds NaN or infinite values")
+    vox = cmap.voxels
+    for name in ("coords", "colors", "weights", "features", "projection", "origin"):
+        a = getattr(vox, name, None)
+        if a is not None and np.asarray(a).dtype.kind == "f" and not np.isfinite(a).all():
+            raise r.fail(f"voxels/{name} holds NaN or infinite values")
+    spec = cmap.occupancy.spec
+    if not np.isfinite([spec.x0, spec.y0, spec.resolution]).all():
+        raise r.fail("the occupancy grid's origin or resolution is not finite")
+    if not np.isfinite(float(vox.resolution)) or vox.resolution <= 0:
+        raise r.fail(f"voxel resolution {vox.resolution} is not a positive number")
+    if cmap.trajectory is not None and not np.isfinite(cmap.trajectory.poses).all():
+        raise r.fail("trajectory/poses holds NaN or infinite values")

@@ -199,8 +199,7 @@ class Mapper:
             "encoder": self.encoder.id,
             "text_space": self.encoder.text_space,
             "config": self.config.to_dict(),
-            "mapping_seconds": round(self.seconds, 3),
-        }
+        }  # no wall-clock time here: the same input gives the same map file, byte for byte (self.seconds)
         info.update(meta or {})
         path = (CameraTrajectory(np.array([i for i, _ in self.camera_path]), np.stack([T for _, T in self.camera_path]))
                 if self.camera_path else None)

@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Any
 
 from capnav.core.errors import FrameError
+from capnav.core.limits import check_count
 from capnav.core.progress import track
 from capnav.io.dataset import DatasetReader
 from capnav.mapping.cmap import CapNavMap
@@ -17,6 +18,7 @@ def map_dataset(path: str | Path | DatasetReader, detector: Detector, encoder: D
                 config: MapperConfig | None = None, max_frames: int | None = None, progress: bool = True
                 ) -> CapNavMap:
     """Build a map from a ``capnav-rgbd`` dataset folder (``capnav.io.dataset``) or its reader."""
+    check_count("max_frames", max_frames, optional=True)
     reader = path if isinstance(path, DatasetReader) else DatasetReader(path)
     path = reader.path
     if detector.needs_truth and not reader.has_gt:
@@ -32,7 +34,9 @@ def map_dataset(path: str | Path | DatasetReader, detector: Detector, encoder: D
             mapper.record_skip(i, e.reason)
             continue
         mapper.integrate(frame)
-    meta: dict[str, Any] = {"dataset": str(Path(path).resolve()), "dataset_frames": len(reader)}
+    # What the map was made from, so caption / map-eval / navigate can refuse another apartment's data.
+    meta: dict[str, Any] = {"dataset": str(Path(path).resolve()), "dataset_frames": len(reader),
+                            "dataset_id": reader.fingerprint()}
     producer = reader.meta.get("meta") or {}
     if producer.get("source") == "capnav.sim" and isinstance(producer.get("seed"), int):
         meta["scene_seed"] = producer["seed"]  # lets `capnav navigate` drive in the same apartment

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 from capnav.core.errors import InputError
 from capnav.core.geometry import Intrinsics
+from capnav.core.limits import HFOV_MAX, HFOV_MIN, check_image_size
 
 
 @dataclass(frozen=True)
@@ -42,10 +43,9 @@ class CameraConfig:
     room_culling: bool = True  # hide rooms no chain of doors makes visible (same pixels, ~2x faster)
 
     def __post_init__(self) -> None:
-        if not (16 <= self.width <= 4096 and 16 <= self.height <= 4096):
-            raise InputError(f"image size must be within 16..4096 pixels, got {self.width}x{self.height}")
-        if not (10.0 <= self.hfov_deg <= 150.0):
-            raise InputError(f"hfov must be within 10..150 degrees, got {self.hfov_deg}")
+        check_image_size(self.width, self.height)
+        if not (HFOV_MIN <= self.hfov_deg <= HFOV_MAX):
+            raise InputError(f"hfov must be within {HFOV_MIN:g}..{HFOV_MAX:g} degrees, got {self.hfov_deg}")
         if not (0 < self.near < self.far):
             raise InputError(f"need 0 < near < far, got near={self.near}, far={self.far}")
 

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from capnav.core.errors import DatasetError
+from capnav.core.atomic import atomic_dir
 from capnav.core.progress import track
-from capnav.io.dataset import DatasetWriter
+from capnav.io.dataset import DatasetWriter, check_dataset_target
 from capnav.sim.config import CameraConfig, DepthNoiseConfig, LayoutConfig, SimConfig
 from capnav.sim.explore import ExploreConfig, plan_exploration
 from capnav.sim.simulator import Simulator
@@ -27,8 +27,7 @@ def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride
     from capnav.viz.scene import draw_scene
 
     out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise DatasetError(f"output {out} exists and is not a folder")
+    check_dataset_target(out, overwrite)
     base = config if config is not None else SimConfig()
     cfg = replace(base, camera=replace(base.camera, width=width, height=height, hfov_deg=hfov)
                   if config is not None else CameraConfig(width=width, height=height, hfov_deg=hfov),
@@ -42,13 +41,15 @@ def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride
         meta = {"source": "capnav.sim", "seed": seed, "furniture": furniture, "rooms": len(sim.manifest.rooms),
                 "objects": len(sim.manifest.objects), "depth_noise": depth_noise, "exploration": "capnav.sim.explore"}
         t1 = time.perf_counter()
-        with DatasetWriter(out, sim.intrinsics, meta, overwrite=overwrite) as writer:
-            for i, T in enumerate(track(poses, f"rendering seed {seed}", enabled=progress)):
-                writer.write(sim.render(T, index=i))
-        t_render = time.perf_counter() - t1
-        sim.manifest.save(out / "manifest.json")
-        traj = np.array([T[:2, 3] for T in poses]) if poses else None
-        draw_scene(sim.manifest, out / "topdown.png", navigable=sim.navigable(), trajectory=traj)
+        # Built in a temporary sibling and swapped in whole: an interrupted --overwrite keeps the old one.
+        with atomic_dir(out, overwrite=overwrite) as tmp:
+            with DatasetWriter(tmp, sim.intrinsics, meta) as writer:
+                for i, T in enumerate(track(poses, f"rendering seed {seed}", enabled=progress)):
+                    writer.write(sim.render(T, index=i))
+            t_render = time.perf_counter() - t1
+            sim.manifest.save(tmp / "manifest.json")
+            traj = np.array([T[:2, 3] for T in poses]) if poses else None
+            draw_scene(sim.manifest, tmp / "topdown.png", navigable=sim.navigable(), trajectory=traj)
         return (f"wrote {len(poses)} frames ({width}x{height}) of apartment seed {seed} "
                 f"({len(sim.manifest.rooms)} rooms, {len(sim.manifest.objects)} objects) to {out} "
                 f"[build {t_build:.2f} s, render+write {t_render:.1f} s]")
