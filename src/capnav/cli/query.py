@@ -46,7 +46,7 @@ def register(app: typer.Typer) -> None:
         check_verifier(verifier)
         if embedder != "auto":
             check_model_folder("--embedder", embedder, embedder_path, "--embedder-path", EMBEDDERS.required(embedder))
-        cmap = load_map(map_path)
+        cmap = load_map(map_path, voxels=False)  # retrieval reads objects and occupancy only
         if embedder == "auto":
             models = {o.embedding_model for o in cmap.objects if o.embedding_model}
             if not models:

@@ -135,7 +135,8 @@ def _cached_map(assets: SceneAssets) -> CapNavMap:
             pass  # a stale or damaged cache is rebuilt below
     cmap = build_scene_map(assets)
     cmap.meta["eval_key"] = key
-    save_map(cmap, path)
+    # float32 features: a rerun from the cache scores exactly what the first run scored
+    save_map(cmap, path, feature_dtype="float32")
     return cmap
 
 

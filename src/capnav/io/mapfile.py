@@ -1,6 +1,6 @@
 """The CapNav map file: one zip archive, no pickle, validated on load.
 
-Layout (format ``capnav-map``, version 2; version 1 files, without the camera trajectory, still load)::
+Layout (format ``capnav-map``, version 3; versions 1 and 2 still load)::
 
     header.json            format, version, and for every other entry: sha256, size, and for
                            arrays their dtype and shape
@@ -24,6 +24,7 @@ import dataclasses
 import hashlib
 import io
 import json
+import warnings
 import zipfile
 import zlib
 from pathlib import Path
@@ -33,15 +34,20 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.core.atomic import write_with
-from capnav.core.errors import CapNavError, MapFileError
+from capnav.core.errors import CapNavError, InputError, MapFileError
 from capnav.core.grid import GridSpec, OccupancyGrid
 from capnav.mapping.cmap import CameraTrajectory, CapNavMap
 from capnav.mapping.objects import MapObject, ObjectView, Observation
 from capnav.mapping.voxel_map import VoxelMap
 
 FORMAT = "capnav-map"
-VERSION = 2
-READS = (1, 2)  # version 1: the same without trajectory/
+VERSION = 3
+# version 1: no trajectory/; version 2: voxel features always float32 and arrays stored
+# uncompressed; version 3: voxel features float16 by default (``save_map(feature_dtype=...)``) and
+# arrays DEFLATE-compressed (level 1: 4x on an apartment's features, ~0.1 s to inflate).
+READS = (1, 2, 3)
+FEATURE_DTYPES = ("float16", "float32")
+_F16_MAX = float(np.finfo(np.float16).max)
 _OBJ_FIELDS = [f.name for f in dataclasses.fields(MapObject)]
 _ARRAY_DTYPES = {"position": np.float64, "extent_min": np.float64, "extent_max": np.float64,
                  "footprint": np.float64, "points": np.float32, "colors": np.uint8, "feature": np.float32,
@@ -99,14 +105,29 @@ def _encode_objects(objects: list[MapObject]) -> tuple[list[dict[str, Any]], dic
     return records, blobs
 
 
-def save_map(cmap: CapNavMap, path: str | Path) -> Path:
-    """Write ``cmap`` to ``path`` atomically (a crash never leaves a half-written map)."""
+def save_map(cmap: CapNavMap, path: str | Path, feature_dtype: str = "float16") -> Path:
+    """Write ``cmap`` to ``path`` atomically (a crash never leaves a half-written map).
+
+    Voxel features (eq. 6) are stored as ``feature_dtype``: float16 by default, half the bytes of
+    the dominant entry at a relative error <= 2^-11 per value. Only dense voxel queries read them
+    (the VLMaps-style baseline); CapNav's object retrieval does not (benchmarks/bench_mapfile.py
+    measures both). ``"float32"`` keeps them bit for bit. Features beyond float16's range are kept
+    in float32 with a warning that says so."""
+    if feature_dtype not in FEATURE_DTYPES:
+        raise InputError(f"feature_dtype must be one of {', '.join(FEATURE_DTYPES)}, got {feature_dtype!r}")
     vox = cmap.voxels
+    feats = vox.features
+    if feature_dtype == "float16":
+        if feats.size and not float(np.max(np.abs(feats))) <= _F16_MAX:
+            warnings.warn(f"voxel features exceed float16's range (|f| > {_F16_MAX:g}) or are not finite; "
+                          "storing them as float32", stacklevel=2)
+        else:
+            feats = feats.astype(np.float16)
     records, blobs = _encode_objects(cmap.objects)
     blobs["voxels/coords.npy"] = _npy(vox.coords)
     blobs["voxels/colors.npy"] = _npy(vox.colors)
     blobs["voxels/weights.npy"] = _npy(vox.weights)
-    blobs["voxels/features.npy"] = _npy(vox.features)
+    blobs["voxels/features.npy"] = _npy(feats)
     if vox.projection is not None:
         blobs["voxels/projection.npy"] = _npy(vox.projection)
     blobs["occupancy/cells.npy"] = _npy(cmap.occupancy.cells)
@@ -135,9 +156,12 @@ def save_map(cmap: CapNavMap, path: str | Path) -> Path:
             for name, data in [*blobs.items(), ("header.json", _json(header, "header"))]:
                 # A fixed timestamp keeps the file bit-identical for identical maps.
                 info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
-                info.compress_type = zipfile.ZIP_DEFLATED if name.endswith(".json") else zipfile.ZIP_STORED
+                # PNGs are compressed already; JSON and arrays deflate (arrays at level 1: most of
+                # the gain at a fifth of level 6's time).
+                png = name.endswith(".png")
+                info.compress_type = zipfile.ZIP_STORED if png else zipfile.ZIP_DEFLATED
                 info.external_attr = 0o644 << 16
-                zf.writestr(info, data)
+                zf.writestr(info, data, compresslevel=None if png or name.endswith(".json") else 1)
 
     out = Path(path)
     write_with(out, writer)
@@ -184,8 +208,12 @@ class _Reader:
         return arr
 
 
-def load_map(path: str | Path) -> CapNavMap:
-    """Read and validate a map file; any problem raises ``MapFileError`` saying what is wrong."""
+def load_map(path: str | Path, voxels: bool = True) -> CapNavMap:
+    """Read and validate a map file; any problem raises ``MapFileError`` saying what is wrong.
+
+    ``voxels=False`` skips the voxel arrays (most of the file): the map gets an empty voxel map
+    with the stored resolution, origin, feature dim and projection. For readers that use only
+    objects and occupancy (``capnav query``); entries not read are not checksummed."""
     p = Path(path)
     if not p.is_file():
         raise MapFileError(f"map file not found: {p}")
@@ -210,23 +238,36 @@ def load_map(path: str | Path) -> CapNavMap:
             raise MapFileError(f"{p}: header has no entry table")
         r = _Reader(p, zf, header)
         try:
-            return _decode(r, header)
+            return _decode(r, header, voxels)
         except MapFileError:
             raise
         except (CapNavError, KeyError, TypeError, ValueError, IndexError) as e:
             raise r.fail(f"inconsistent content ({type(e).__name__}: {e})") from None
 
 
-def _decode(r: _Reader, header: dict[str, Any]) -> CapNavMap:
+def _features(r: _Reader) -> NDArray[np.float32]:
+    """Voxel features as float32 (stored float16 since version 3, float32 before)."""
+    f = r.array("voxels/features.npy")
+    if f.dtype not in (np.float16, np.float32):
+        raise r.fail(f"voxels/features.npy is {f.dtype}, expected float16 or float32")
+    return f.astype(np.float32, copy=False)
+
+
+def _decode(r: _Reader, header: dict[str, Any], with_voxels: bool = True) -> CapNavMap:
     vh = header["voxels"]
     proj = r.array("voxels/projection.npy") if "voxels/projection.npy" in r.entries else None
-    coords = r.array("voxels/coords.npy")
-    n = int(header["n_voxels"])
-    if coords.shape != (n, 3):
-        raise r.fail(f"voxels/coords has shape {coords.shape}, header says {n} voxels")
-    voxels = VoxelMap.from_arrays(float(vh["resolution"]), np.asarray(vh["origin"]), coords,
-                                  r.array("voxels/colors.npy"), r.array("voxels/weights.npy"),
-                                  r.array("voxels/features.npy"), proj, str(vh.get("text_space", "")))
+    if with_voxels:
+        coords = r.array("voxels/coords.npy")
+        n = int(header["n_voxels"])
+        if coords.shape != (n, 3):
+            raise r.fail(f"voxels/coords has shape {coords.shape}, header says {n} voxels")
+        colors, weights, feats = r.array("voxels/colors.npy"), r.array("voxels/weights.npy"), _features(r)
+    else:
+        dim = int(vh.get("dim", 0))
+        coords, colors, weights = np.zeros((0, 3), np.int32), np.zeros((0, 3), np.float32), np.zeros(0)
+        feats = np.zeros((0, dim), np.float32)
+    voxels = VoxelMap.from_arrays(float(vh["resolution"]), np.asarray(vh["origin"]), coords, colors, weights,
+                                  feats, proj, str(vh.get("text_space", "")))
     spec = GridSpec(**header["occupancy"])
     occ = OccupancyGrid(spec, r.array("occupancy/cells.npy"))
     records = r.json("objects.json")
