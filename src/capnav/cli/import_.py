@@ -19,8 +19,8 @@ if TYPE_CHECKING:
 Out = Annotated[Path, typer.Option("-o", "--out", help="dataset folder to create")]
 MaxDt = Annotated[float, typer.Option("--max-dt", help="max colour-depth time difference (s)")]
 MaxPoseGap = Annotated[float, typer.Option("--max-pose-gap", help="max gap between the pose stamps around a frame (s)")]
-Stride = Annotated[int, typer.Option("--stride", help="keep every k-th associated frame")]
-MaxFrames = Annotated[int | None, typer.Option("--max-frames", help="keep only the first N selected frames")]
+Stride = Annotated[int, typer.Option("--stride", min=1, help="keep every k-th associated frame")]
+MaxFrames = Annotated[int | None, typer.Option("--max-frames", min=1, help="keep only the first N selected frames")]
 Up = Annotated[str, typer.Option("--up", help="'auto' finds up from the floor and the cameras (refuses when unsure); "
                                               "an axis (+z, -y, ...) is refined by the floor and checked; 'none' "
                                               "keeps the recorded frame")]
@@ -33,10 +33,13 @@ def _import(reader: Callable[[], Recording], out: Path, up: str, stride: int, ma
     """Check ``--up`` before opening the recording, import it, print what was kept and skipped."""
     from rich.console import Console
 
+    from capnav.cli.options import check_output_dir, on_interrupt
     from capnav.io.align import parse_up
     from capnav.io.importer import import_recording
 
+    check_output_dir(out, "--out", must_be_empty=True, overwrite=overwrite)
     parse_up(up)
+    on_interrupt(f"{out} was left as it was (the dataset is built beside it and swapped in only when complete)")
     report = import_recording(reader(), out, up=up, stride=stride, max_frames=max_frames, overwrite=overwrite,
                               progress=progress)
     con = Console(stderr=True, soft_wrap=True)

@@ -48,20 +48,30 @@ def register(app: typer.Typer) -> None:
         the map's frame (JSON, PNG, ROS map_server PGM + YAML), driven in the simulator for sim maps."""
         from rich.console import Console
 
+        from capnav.cli.options import check_map_scene, check_model_folder, check_output_dir, check_verifier
         from capnav.core.errors import InputError
         from capnav.io.mapfile import load_map
         from capnav.language import create_embedder
+        from capnav.language.embedder import EMBEDDERS
         from capnav.planning.instruction import OCCUPANCY_KINDS, episode_start, parse_pose
         from capnav.retrieval import Retriever, create_verifier
 
         if occupancy not in OCCUPANCY_KINDS:  # fail before the slow loading below
             raise InputError(f"occupancy must be one of {', '.join(OCCUPANCY_KINDS)}, got {occupancy!r}")
+        check_output_dir(out, "--out")
+        check_verifier(verifier)
+        check_model_folder("--embedder", embedder, embedder_path, "--embedder-path", EMBEDDERS.required(embedder))
         given = parse_pose(start) if start else None
         ep_scene = None
         if episode is not None:
             ep_scene, ep_pose = episode_start(episode, episode_id)
             given = given or ep_pose
         cmap = load_map(map_file)
+        # The map, --scene and the episode must be the same apartment (the map records where it was made).
+        check_map_scene(cmap.meta, map_file, scene, f"--scene {scene}")
+        check_map_scene(cmap.meta, map_file, ep_scene, f"the episode in {episode}")
+        if scene is not None and ep_scene is not None and scene != ep_scene:
+            raise InputError(f"--scene {scene} is not the episode's apartment {ep_scene} ({episode})")
         scene_seed = next((s for s in (scene, ep_scene, cmap.meta.get("scene_seed")) if s is not None), None)
         if drive and scene_seed is None:
             raise InputError(f"{map_file} records no scene seed to drive in (a map of a recording): pass --scene "
