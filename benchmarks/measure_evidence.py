@@ -6,7 +6,8 @@ manifest: colour name, room, model size), never from instructions:
 
 * colour: the agreement (``OfflineVerifier.color``) of an object's observed colours with its true
   colour word, against the agreement with colour words a person would not use for it (CIEDE2000
-  to the true word above ``--far``). ``color_reject`` keeps all but ``--miss`` of the true words;
+  to the true word above ``--far``, and the true colour no shade of the word). ``color_reject``
+  keeps all but ``--miss`` of the true words;
   ``color_match`` (negation: "not the white one") is reached by no more than ``--miss`` of the
   wrong words.
 * size: mapped volume ratio of two objects of one truth model and size (should be 1); the ratio
@@ -34,7 +35,7 @@ from capnav.language import SceneContext, create_embedder
 from capnav.language.colors import LEX_LAB, NAMES, canonical_color, ciede2000
 from capnav.language.context import label_of
 from capnav.retrieval.query import ParsedQuery
-from capnav.retrieval.verifier import OfflineVerifier, OfflineVerifierConfig
+from capnav.retrieval.verifier import OfflineVerifier, OfflineVerifierConfig, shades
 from eval_retrieval import build, instance_of
 
 
@@ -70,7 +71,9 @@ def main() -> None:
                 text = "the plant in the pot" if truth.category == "plant" else "the object"
                 true_agree.append(judge.color(ParsedQuery(text=text, colors=[word]), o)[0])
                 d = ciede2000(LEX_LAB[NAMES.index(word)][None], LEX_LAB, kL=2.0)
-                for w in (NAMES[k] for k in np.flatnonzero(d > args.far)):
+                # A word is wrong when far from the true colour and not one of its shades (grey for
+                # a dark grey object: people say that).
+                for w in (NAMES[k] for k in np.flatnonzero(d > args.far) if word not in shades(NAMES[k])):
                     wrong_agree.append(judge.color(ParsedQuery(text=text, colors=[w]), o)[0])
             said = scene.room_of(o)
             real = room_name[truth.room]

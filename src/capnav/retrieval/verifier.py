@@ -26,7 +26,8 @@ import numpy as np
 from capnav.core.errors import CapNavError
 from capnav.core.registry import Registry
 from capnav.language.captioner import RetryPolicy
-from capnav.language.colors import ColorCluster, color_agreement
+from capnav.language.colors import NAMES as COLOR_NAMES
+from capnav.language.colors import ColorCluster, canonical_color, color_agreement
 from capnav.language.context import SceneContext, canonical_label
 from capnav.language.embedder import TextEmbedder
 from capnav.language.offline_captioner import ObservationCaptioner
@@ -41,6 +42,13 @@ log = logging.getLogger(__name__)
 def a(noun: str) -> str:
     """'a chair', 'an armchair'."""
     return f"an {noun}" if noun[:1].lower() in "aeiou" else f"a {noun}"
+
+
+def shades(word: str) -> list[str]:
+    """A spoken colour and its lighter and darker shades ("blue": light blue; "grey": light grey,
+    dark grey): a person says "the blue sofa" of a light blue one."""
+    name = canonical_color(word) or word
+    return [name, *(n for n in COLOR_NAMES if n.split()[0] in ("light", "dark") and n.split()[-1] == name)]
 
 
 @dataclass
@@ -112,10 +120,11 @@ class OfflineVerifierConfig:
     observed and the scene's truth; they are not fitted to any instruction."""
 
     name_threshold: float = 0.78  # cosine between target noun and caption name for a non-category match
-    #: Agreement exp(-ΔE00/12) below which the spoken colour disagrees with every observed colour:
-    #: 98% of objects agree at least this much with their own colour word, 95% of the words a person
-    #: would not use for them (ΔE00 > 20 away) fall below it (measure_evidence.py, seeds 1 2 3).
-    color_reject: float = 0.29
+    #: Agreement exp(-ΔE00/12) below which the spoken colour (or a shade of it) disagrees with
+    #: every observed colour: 98% of objects agree at least this much with their own colour word,
+    #: 95.4% of the words a person would not use for them (ΔE00 > 20 away, no shade of theirs) fall
+    #: below it (benchmarks/measure_evidence.py --seeds 1 2 3).
+    color_reject: float = 0.30
     #: At or above this agreement an object "is" that colour, so "not the white one" excludes it:
     #: reached by 2% of the wrong words and 90% of the true ones (same measurement).
     color_match: float = 0.42
@@ -125,6 +134,9 @@ class OfflineVerifierConfig:
     #: A colour cluster covering under half of the object counts from this floor up to 1 at half
     #: (0.2 separates true from wrong colour words better than 0.6: 95.0% vs 93.2% refused).
     color_floor: float = 0.2
+    #: A shade of the spoken colour (light blue for "blue") counts at this share, so the colour
+    #: itself wins when both are in the map.
+    shade_weight: float = 0.5
     w_rank: float = 0.5
     w_color: float = 1.0
     w_size: float = 0.6
@@ -210,8 +222,9 @@ class OfflineVerifier(Verifier):
         vals = []
         for word in words:
             floor = self.config.color_floor
-            vals.append(max(color_agreement(word, c.lab) * (floor + (1.0 - floor) * min(1.0, c.fraction / 0.5))
-                            for c in cols))
+            vals.append(max(color_agreement(w, c.lab) * (floor + (1.0 - floor) * min(1.0, c.fraction / 0.5))
+                            * (1.0 if k == 0 else self.config.shade_weight)
+                            for c in cols for k, w in enumerate(shades(word))))
         agree = float(np.mean(vals))
         return agree, f"colour {'/'.join(words)} vs observed {cols[0].name} (agreement {agree:.2f})"
 
@@ -232,7 +245,7 @@ class OfflineVerifier(Verifier):
         """Judge one candidate; ``position`` in [0, 1) is its place in the batch (0 = first)."""
         cfg = self.config
         ok, weight, why = self.name_agreement(query, c.obj)
-        terms: dict[str, float] = {"similarity": round(c.score, 3)}
+        terms: dict[str, float] = {"similarity": round(c.score, 3), "rank": round(1.0 - position, 3)}
         if not ok:
             return Assessment(False, 0.0, terms, why)
         if weight < 1.0:
