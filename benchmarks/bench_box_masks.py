@@ -14,7 +14,7 @@ Truth is read here only (evaluation).
    (what the mask took in from the wall, floor or neighbours), for ``method="mode"`` (the
    nearest strong depth mode grown along smooth depth, before issue 11) and ``"surfaces"``.
 2. Per map: the whole pass mapped with those masks (labels from the truth, every
-   ``--map-stride``-th frame), objects matched to instances by ``capnav.mapping.quality``, and
+   ``--map-stride``-th frame), objects matched to instances by ``capnav.eval.map_quality``, and
    the size error of each matched instance's object (``quality.size_error``: the larger of the
    caption width and height errors), median per category.
 """
@@ -115,9 +115,9 @@ def per_view(frames: list[Frame], pad: float) -> tuple[dict[str, dict[str, list[
 
 
 def map_sizes(data: Path, method: str, pad: float, stride: int) -> dict[str, list[float]]:
+    from capnav.eval.map_quality import evaluate_map
     from capnav.io.dataset import DatasetReader
     from capnav.mapping import build_map
-    from capnav.mapping.quality import evaluate_map
     from capnav.sim.manifest import SceneManifest
 
     reader = DatasetReader(data)

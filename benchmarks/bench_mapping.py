@@ -277,9 +277,9 @@ def _memory_probe(seed: int, noise: str) -> None:
 
 
 def quality(seeds: list[int], noise: str) -> list[list[str]]:
+    from capnav.eval.map_quality import evaluate_map, visible_frames
     from capnav.language import create_embedder
     from capnav.mapping import build_map
-    from capnav.mapping.quality import evaluate_map, visible_frames
     from capnav.perception import create_detector, create_encoder
 
     emb = create_embedder("minilm")

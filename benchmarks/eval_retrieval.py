@@ -4,7 +4,7 @@ For each apartment seed: record the exploration pass (``capnav sim`` defaults), 
 simulator detector at its default noise, describe the map with the offline captioner and the
 MiniLM embedder, then ask generated instructions (``capnav.eval.instructions``) and score the
 answers against the scene truth. A chosen object counts as an instance when most of its points
-lie inside that instance's box (the rule of ``capnav.mapping.quality``).
+lie inside that instance's box (the rule of ``capnav.eval.map_quality``).
 
     .venv/bin/python benchmarks/eval_retrieval.py --seeds 1 2 3 --per-kind 20 --work /tmp/capnav-eval
 """
@@ -20,13 +20,13 @@ from pathlib import Path
 import numpy as np
 
 from capnav.eval.instructions import KINDS, Instruction, generate_instructions
+from capnav.eval.map_quality import inside_box
 from capnav.io.dataset import DatasetReader
 from capnav.io.mapfile import load_map, save_map
 from capnav.language import create_captioner, create_embedder, describe_map
 from capnav.mapping import MapperConfig, map_dataset
 from capnav.mapping.cmap import CapNavMap
 from capnav.mapping.objects import MapObject
-from capnav.mapping.quality import inside_box
 from capnav.perception import create_detector, create_encoder
 from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
 from capnav.sim.manifest import SceneManifest

@@ -217,6 +217,23 @@ class CapNav:
         nav._frames = reader if reader is not None else _FrameStore(kept)
         return nav
 
+    @classmethod
+    def simulate(cls, scene_seed: int, folder: str | Path, *, seed: int = 0, config: Any = None,
+                 **kwargs: Any) -> CapNav:
+        """The map of generated apartment ``scene_seed`` made by the product pipeline (explore, map,
+        caption, embed; ``capnav.pipeline``), cached as ``folder/map.capnav``. ``config``: a
+        ``PipelineConfig`` (image size, frames, detector noise, ...)."""
+        from capnav.pipeline import PipelineConfig, open_sim_scene
+
+        scene = open_sim_scene(scene_seed, seed, config or PipelineConfig(), Path(folder))
+        try:
+            cmap = scene.prior_map()
+        finally:
+            scene.sim.close()
+        nav = cls(cmap, embedder=scene.embedder, source=Path(folder) / "map.capnav", **kwargs)
+        nav._frames = scene.frames
+        return nav
+
     def caption(self, frames: Any = None, captioner: str = "offline", embedder: str | TextEmbedder | None = None,
                 *, progress: bool = False, **captioner_options: Any) -> DescribeReport:
         """Choose views, caption and embed every object (paper 3.3), in place. ``frames``: a reader

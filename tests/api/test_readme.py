@@ -29,3 +29,15 @@ def test_readme_api_example_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch
     assert answer.found and "armchair" in answer.object.caption.lower()  # type: ignore[attr-defined]
     assert answer.goal is not None and plan.success  # type: ignore[attr-defined]
     assert len(nav.objects()) >= 5 and answer.reason in out  # type: ignore[attr-defined]
+
+
+def test_simulate_uses_the_product_pipeline(tmp_path: Path) -> None:
+    from capnav.api import CapNav
+    from capnav.pipeline import PipelineConfig
+
+    cfg = PipelineConfig(width=160, height=120, max_frames=30)
+    nav = CapNav.simulate(0, tmp_path, config=cfg)
+    assert (tmp_path / "map.capnav").is_file() and nav.objects() and all(o.caption for o in nav.objects())
+    again = CapNav.simulate(0, tmp_path, config=cfg)  # cached: the same map, not rebuilt
+    assert [o.caption for o in again.objects()] == [o.caption for o in nav.objects()]
+    assert nav.ask("the armchair").found

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from capnav.core.grid import OCCUPIED
+from capnav.eval.map_quality import evaluate_map, inside_box, visible_frames
 from capnav.io.mapfile import load_map, save_map
 from capnav.mapping import CapNavMap, Mapper, MapperConfig
-from capnav.mapping.quality import evaluate_map, inside_box, visible_frames
 from capnav.perception import create_detector, create_encoder
 
 pytestmark = pytest.mark.slow

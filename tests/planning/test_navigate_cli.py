@@ -18,10 +18,10 @@ pytestmark = pytest.mark.slow  # explores, maps and captions a (small) apartment
 
 @pytest.fixture(scope="module")
 def small_map(tmp_path_factory):
-    from capnav.eval.pipeline import PipelineConfig, open_scene
+    from capnav.pipeline import PipelineConfig, open_sim_scene
 
     folder = tmp_path_factory.mktemp("map")
-    assets = open_scene(SCENE, SCENE, PipelineConfig(width=160, height=120, max_frames=40), folder)
+    assets = open_sim_scene(SCENE, SCENE, PipelineConfig(width=160, height=120, max_frames=40), folder)
     cmap = assets.prior_map()
     assets.sim.close()
     return folder / "map.capnav", cmap

@@ -41,8 +41,8 @@ def register(app: typer.Typer) -> None:
         from capnav.eval.benchmark import run_benchmark
         from capnav.eval.episodes import parse_protocols
         from capnav.eval.method import load_methods
-        from capnav.eval.pipeline import PipelineConfig
         from capnav.eval.scene_task import DEFAULT_METHODS, EvalConfig
+        from capnav.pipeline import PipelineConfig
 
         if methods == "all":
             names = DEFAULT_METHODS + tuple(m for m in load_methods() if m not in DEFAULT_METHODS)

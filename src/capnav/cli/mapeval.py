@@ -23,8 +23,8 @@ def register(app: typer.Typer) -> None:
 
         from capnav.cli.options import check_map_scene, check_output_file
         from capnav.core.atomic import write_json
+        from capnav.eval.map_quality import evaluate_map, truth_for_dataset
         from capnav.io.mapfile import load_map
-        from capnav.mapping.quality import evaluate_map, truth_for_dataset
         from capnav.sim.manifest import SceneManifest
 
         if json_out is not None:

@@ -50,10 +50,10 @@ def register(app: typer.Typer) -> None:
 
         from capnav.cli.options import check_map_scene, check_model_folder, check_output_dir, check_verifier
         from capnav.core.errors import InputError
+        from capnav.eval.drive import OCCUPANCY_KINDS, episode_start, parse_pose
         from capnav.io.mapfile import load_map
         from capnav.language import create_embedder
         from capnav.language.embedder import EMBEDDERS
-        from capnav.planning.instruction import OCCUPANCY_KINDS, episode_start, parse_pose
         from capnav.retrieval import Retriever, create_verifier
 
         if occupancy not in OCCUPANCY_KINDS:  # fail before the slow loading below
@@ -85,8 +85,8 @@ def register(app: typer.Typer) -> None:
         if drive is False or scene_seed is None:
             _plan_only(con, cmap, retriever, instruction, given, out, map_file)
             return
+        from capnav.eval.drive import random_start, run_instruction
         from capnav.io.rosmap import write_ros_map
-        from capnav.planning.instruction import random_start, run_instruction
         from capnav.sim import Simulator
 
         with Simulator.from_seed(int(scene_seed)) as sim:

@@ -18,13 +18,15 @@ from rich.console import Console
 
 from capnav.core.atomic import write_bytes, write_json
 from capnav.core.errors import CapNavError, InputError
+from capnav.core.grid import FREE
 from capnav.core.limits import check_count, check_image_size
 from capnav.demo.report import Report, ReportItem, verdict, write_html, write_markdown
-from capnav.eval.pipeline import PipelineConfig, open_scene
+from capnav.eval.drive import run_instruction
+from capnav.eval.generate import SceneTruth
 from capnav.eval.success import SUCCESS_RADIUS_M, distance_to_instances
 from capnav.mapping.objects import MapObject
+from capnav.pipeline import PipelineConfig, SimScene, open_sim_scene
 from capnav.planning import PlannerConfig
-from capnav.planning.instruction import run_instruction
 from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
 
 #: One instruction of each kind by default: what CapNav is for first, then the classic cases.
@@ -88,13 +90,15 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
     pcfg = PipelineConfig(width=cfg.width, height=cfg.height, max_frames=cfg.max_frames,
                           captioner=cfg.captioner, verifier=cfg.verifier)
     con.print(f"[bold]1/4[/] apartment seed {cfg.seed}: building the simulator")
-    assets = open_scene(cfg.seed, cfg.seed, pcfg, out)
+    assets = open_sim_scene(cfg.seed, cfg.seed, pcfg, out)  # the product pipeline: it never reads the truth
     sim = assets.sim
+    nav_truth = sim.navigable()  # the simulator's truth: only to pick starts and instructions and to judge
+    truth = SceneTruth.from_manifest(sim.manifest, nav_truth.spec, nav_truth.cells == FREE)
     con.print(f"     {len(sim.manifest.rooms)} rooms, {len(sim.manifest.objects)} objects "
               f"({time.perf_counter() - t0:.1f} s)")
     from capnav.viz.scene import draw_scene
 
-    draw_scene(sim.manifest, out / "images" / "apartment.png", navigable=sim.navigable(), id_prefix="T",
+    draw_scene(sim.manifest, out / "images" / "apartment.png", navigable=nav_truth, id_prefix="T",
                title=f"apartment seed {cfg.seed} as simulated (truth; T-numbers are truth ids, not map ids)")
 
     t1 = time.perf_counter()
@@ -106,7 +110,7 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
 
     retriever = Retriever(cmap, assets.embedder, create_verifier(cfg.verifier), RetrievalConfig())
     rng = np.random.default_rng(cfg.seed + 1)
-    start = assets.truth.sample_start(rng)
+    start = truth.sample_start(rng)
     agent = sim.spawn_agent(start.x, start.y, start.yaw)
     n = len(cfg.instructions) or len(cfg.kinds)
 
@@ -120,7 +124,7 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
             con.print(f"     (this apartment allows no {cfg.kinds[k]!r} instruction; skipped)")
             continue
         text, kind, targets = nxt
-        it = _answer(len(items) + 1, text, kind, targets, retriever, agent, cmap, assets, pcfg_plan, out)
+        it = _answer(len(items) + 1, text, kind, targets, retriever, agent, cmap, assets, truth, pcfg_plan, out)
         items.append(it)
         con.print(f"     {len(items)}. \\[{kind}] {text!r}: {it.chosen_label or '-'}: {verdict(it)}")
 
@@ -149,7 +153,7 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
 
 
 def _answer(k: int, text: str, kind: str, targets: list[int], retriever: Retriever, agent: Any, cmap: Any,
-            assets: Any, plan_cfg: PlannerConfig, out: Path) -> ReportItem:
+            assets: SimScene, truth: SceneTruth, plan_cfg: PlannerConfig, out: Path) -> ReportItem:
     try:
         res = run_instruction(cmap, assets.sim, retriever, text, agent=agent, config=plan_cfg,
                               out_dir=out / "images", stem=f"{k:02d}_nav")
@@ -163,10 +167,10 @@ def _answer(k: int, text: str, kind: str, targets: list[int], retriever: Retriev
     if kind == "absent":
         item.correct = not q.found
     elif targets:  # right only when the agent stops within reach of an instance the instruction meant
-        fps = [assets.truth.footprints[t] for t in targets]
+        fps = [truth.footprints[t] for t in targets]
         if obj is not None:  # the chosen object is right when the nearest true instance to it is meant
-            near = min(assets.truth.footprints, key=lambda i: distance_to_instances(
-                obj.position[:2], [assets.truth.footprints[i]]))
+            near = min(truth.footprints, key=lambda i: distance_to_instances(
+                obj.position[:2], [truth.footprints[i]]))
             item.right_object = near in targets
         if nav is not None:
             item.truth_distance = distance_to_instances(nav.final_pose[:2], fps)

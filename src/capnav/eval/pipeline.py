@@ -1,160 +1,36 @@
-"""Per-apartment artefacts shared by every method: simulator, exploration stream, prior map, truth.
-
-The exploration stream is regenerated deterministically from (scene seed, settings) when needed;
-the prior map (tracked objects, captions, embeddings, voxels, occupancy) is built ONCE per apartment
-and cached in the run folder, keyed by the settings that made it and by the apartment's manifest,
-so every map-based method of a run, and every rerun, uses the identical map. (A change to the
-mapping code itself is not detected: delete ``scenes/*/map.capnav`` after one.)
-"""
+"""Per-apartment artefacts shared by every method: the product pipeline's simulated apartment
+(``capnav.pipeline``: simulator, exploration stream, prior map) plus the simulator's truth that
+the harness scores against. Only this side reads the truth."""
 
 from __future__ import annotations
 
-import hashlib
-import json
 import time
-from collections.abc import Iterator
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 
-from capnav.core.errors import CapNavError
-from capnav.core.frame import Frame
 from capnav.core.grid import FREE
 from capnav.eval.generate import SceneTruth
 from capnav.language.embedder import TextEmbedder
-from capnav.mapping.cmap import CapNavMap
-from capnav.perception.base import Detector
-from capnav.sim import CameraConfig, ExploreConfig, SimConfig, Simulator, explore
+from capnav.pipeline.simulated import MAP_FILE, FrameList, PipelineConfig, SimScene, build_scene_map, open_sim_scene
 
-MAP_FILE = "map.capnav"
-
-
-@dataclass(frozen=True)
-class PipelineConfig:
-    """How each apartment is observed and mapped (the offline defaults of the benchmark)."""
-
-    width: int = 320  # camera image size (pixels)
-    height: int = 240
-    max_frames: int | None = None  # subsample the exploration stream (None: all, ~200-400 frames)
-    detector: str = "sim"
-    detector_noise: str = "default"
-    encoder: str = "label-embedding"
-    embedder: str = "minilm"
-    captioner: str = "offline"
-    verifier: str = "offline"
-
-    def sim_config(self) -> SimConfig:
-        return SimConfig(camera=CameraConfig(width=self.width, height=self.height))
-
-    def explore_config(self, seed: int) -> ExploreConfig:
-        return ExploreConfig(seed=seed, max_frames=self.max_frames)
-
-    def map_key(self, scene_seed: int, seed: int) -> str:
-        """What the cached map depends on; a cached map with another key is rebuilt."""
-        blob = json.dumps({"scene": scene_seed, "seed": seed, **asdict(self)}, sort_keys=True)
-        return hashlib.sha256(blob.encode()).hexdigest()[:16]
-
-
-class FrameList:
-    """An in-memory exploration stream with the reader interface (``len``, ``frame(i)``, iteration)."""
-
-    def __init__(self, frames: list[Frame]) -> None:
-        self.frames = frames
-
-    def __len__(self) -> int:
-        return len(self.frames)
-
-    def frame(self, index: int) -> Frame:
-        return self.frames[index]
-
-    def __iter__(self) -> Iterator[Frame]:
-        return iter(self.frames)
+__all__ = ["MAP_FILE", "FrameList", "PipelineConfig", "SceneAssets", "build_scene_map", "open_scene"]
 
 
 @dataclass
-class SceneAssets:
-    """One apartment, ready to evaluate in. ``frames`` is filled lazily (``stream()``)."""
+class SceneAssets(SimScene):
+    """One apartment, ready to evaluate in: the product's ``SimScene`` and its ``truth``."""
 
-    scene_seed: int
-    seed: int
-    config: PipelineConfig
-    sim: Simulator
-    truth: SceneTruth
-    embedder: TextEmbedder
-    detector: Detector
-    folder: Path
-    cmap: CapNavMap | None = None
-    frames: FrameList | None = None
-    timings: dict[str, float] = field(default_factory=dict)
-
-    def stream(self) -> FrameList:
-        """The shared exploration stream (regenerated deterministically on first use)."""
-        if self.frames is None:
-            t0 = time.perf_counter()
-            self.frames = FrameList(list(explore(self.sim, self.config.explore_config(self.seed))))
-            self.timings["explore"] = self.timings.get("explore", 0.0) + time.perf_counter() - t0
-        return self.frames
-
-    def prior_map(self) -> CapNavMap:
-        """The apartment's map, loaded from the run folder or built (then saved) from the stream."""
-        if self.cmap is None:
-            self.cmap = _cached_map(self)
-        return self.cmap
+    truth: SceneTruth = field(kw_only=True)
 
 
 def open_scene(scene_seed: int, seed: int, config: PipelineConfig, folder: Path,
                embedder: TextEmbedder | None = None) -> SceneAssets:
     """Simulator, ground truth and shared models of one apartment (no map yet: see ``prior_map``)."""
-    from capnav.language import create_embedder
-    from capnav.perception import create_detector
-
+    scene = open_sim_scene(scene_seed, seed, config, folder, embedder)
     t0 = time.perf_counter()
-    sim = Simulator.from_seed(scene_seed, config.sim_config())
-    nav = sim.navigable()
-    truth = SceneTruth.from_manifest(sim.manifest, nav.spec, nav.cells == FREE)
-    emb = embedder or create_embedder(config.embedder)
-    det = create_detector(config.detector, noise=config.detector_noise, seed=seed)
-    folder.mkdir(parents=True, exist_ok=True)
-    return SceneAssets(scene_seed, seed, config, sim, truth, emb, det, folder,
-                       timings={"simulator": time.perf_counter() - t0})
-
-
-def _cached_map(assets: SceneAssets) -> CapNavMap:
-    from capnav.io.mapfile import load_map, save_map
-
-    path = assets.folder / MAP_FILE
-    # the apartment itself is part of the key: a changed simulator makes a different apartment
-    # from the same seed, and a map of the old one must not be scored against the new truth
-    scene = hashlib.sha256(assets.sim.manifest.model_dump_json().encode()).hexdigest()[:16]
-    key = f"{assets.config.map_key(assets.scene_seed, assets.seed)}-{scene}"
-    if path.is_file():
-        try:
-            cmap = load_map(path)
-            if cmap.meta.get("eval_key") == key:
-                return cmap
-        except CapNavError:
-            pass  # a stale or damaged cache is rebuilt below
-    cmap = build_scene_map(assets)
-    cmap.meta["eval_key"] = key
-    # float32 features: a rerun from the cache scores exactly what the first run scored
-    save_map(cmap, path, feature_dtype="float32")
-    return cmap
-
-
-def build_scene_map(assets: SceneAssets) -> CapNavMap:
-    """Map the exploration stream with the shared detector, then caption and embed every object."""
-    from capnav.language.captioner import create_captioner
-    from capnav.language.describe import describe_map
-    from capnav.mapping.mapper import build_map
-    from capnav.perception import create_encoder
-
-    frames = assets.stream()
-    t0 = time.perf_counter()
-    enc = create_encoder(assets.config.encoder, embedder=assets.embedder)
-    cmap = build_map(iter(frames), detector=assets.detector, encoder=enc, progress=False, total=len(frames),
-                     meta={"scene_seed": assets.scene_seed, "source": "capnav eval exploration stream"})
-    t1 = time.perf_counter()
-    describe_map(cmap, frames, create_captioner(assets.config.captioner), assets.embedder, progress=False)
-    t2 = time.perf_counter()
-    assets.timings["map"] = t1 - t0
-    assets.timings["caption"] = t2 - t1
-    return cmap
+    nav = scene.sim.navigable()
+    truth = SceneTruth.from_manifest(scene.sim.manifest, nav.spec, nav.cells == FREE)
+    timings = dict(scene.timings)
+    timings["simulator"] = timings.get("simulator", 0.0) + time.perf_counter() - t0
+    return SceneAssets(scene.scene_seed, scene.seed, scene.config, scene.sim, scene.embedder, scene.detector,
+                       scene.folder, timings=timings, truth=truth)

@@ -25,7 +25,8 @@ from capnav.eval.episodes import PROTOCOLS, Episode, check_against_manifest
 from capnav.eval.generate import EpisodeConfig, description_episodes, label_episodes
 from capnav.eval.method import SceneContext, create_method
 from capnav.eval.metrics import SubgoalRecord
-from capnav.eval.pipeline import PipelineConfig, SceneAssets, open_scene
+from capnav.eval.pipeline import SceneAssets, open_scene
+from capnav.pipeline import PipelineConfig
 
 RESULT_FILE = "result.json"
 

@@ -82,10 +82,8 @@ class RemoteCaptioner(Captioner):
 
     @property
     def fallback(self) -> Captioner:
-        if self._fallback is None:
-            from capnav.language.offline_captioner import ObservationCaptioner
-
-            self._fallback = ObservationCaptioner()
+        if self._fallback is None:  # by name: this module must not import the offline captioner (an import circle)
+            self._fallback = CAPTIONERS.create("offline")
         return self._fallback
 
     @abstractmethod

@@ -10,14 +10,12 @@ from capnav.planning.config import PlannerConfig
 from capnav.planning.costmap import Costmap, build_costmap
 from capnav.planning.execute import NavResult, navigate_to
 from capnav.planning.goal import GoalPose, select_goal
-from capnav.planning.instruction import InstructionOutcome, run_instruction
 from capnav.planning.path import PlannedPath, plan_path
 
 __all__ = [
     "BACKENDS",
     "Costmap",
     "GoalPose",
-    "InstructionOutcome",
     "NavResult",
     "PlannedPath",
     "PlannerConfig",
@@ -25,6 +23,5 @@ __all__ = [
     "navigate_to",
     "path_cost",
     "plan_path",
-    "run_instruction",
     "select_goal",
 ]

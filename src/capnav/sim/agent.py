@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -13,7 +13,25 @@ from capnav.core.frame import Frame
 from capnav.core.geometry import look_at_pose
 
 if TYPE_CHECKING:
-    from capnav.sim.simulator import Simulator
+    from capnav.core.geometry import Intrinsics
+    from capnav.sim.config import SimConfig
+    from capnav.sim.manifest import SceneManifest
+
+
+class AgentWorld(Protocol):
+    """What an agent needs of its world (``capnav.sim.Simulator``, which imports this module: typed
+    structurally so the two do not import each other)."""
+
+    config: SimConfig
+
+    @property
+    def manifest(self) -> SceneManifest: ...
+
+    def collides(self, x: float, y: float) -> bool: ...
+
+    def collides_many(self, xy: NDArray[np.floating]) -> NDArray[np.bool_]: ...
+
+    def render(self, T_wc: NDArray[np.floating], K: Intrinsics | None = None, index: int = 0) -> Frame: ...
 
 ACTIONS = ("move_forward", "turn_left", "turn_right", "stop")
 _SWEEP = 0.02  # collision sampling step along a motion (m); refined by bisection to 1 mm
@@ -26,7 +44,7 @@ class Agent:
     footprints); a blocked motion stops at contact and reports False.
     """
 
-    def __init__(self, sim: Simulator, x: float, y: float, yaw: float = 0.0) -> None:
+    def __init__(self, sim: AgentWorld, x: float, y: float, yaw: float = 0.0) -> None:
         if not all(math.isfinite(v) for v in (x, y, yaw)):
             raise InputError(f"agent pose must be finite, got ({x}, {y}, {yaw})")
         if sim.collides(x, y):

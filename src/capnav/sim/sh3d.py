@@ -19,7 +19,7 @@ import tempfile
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -30,7 +30,6 @@ from capnav.core.progress import track
 
 if TYPE_CHECKING:
     from capnav.sim.apartment import SceneObject
-    from capnav.sim.world import BulletWorld
 
 PACKAGE = "sweethome3d-furniture"
 CATALOG_VERSION = 1
@@ -312,7 +311,16 @@ def load_catalog(dest: Path | None = None) -> list[MeshModel]:
     return out
 
 
-def build_mesh_body(world: BulletWorld, o: SceneObject) -> int:
+class MeshWorld(Protocol):
+    """What ``build_mesh_body`` needs of a pybullet world (``capnav.sim.world.BulletWorld``, which
+    imports this module: typed structurally so the two do not import each other)."""
+
+    p: Any
+    client: int
+    _colors: dict[int, list[tuple[int, list[float]]]]
+
+
+def build_mesh_body(world: MeshWorld, o: SceneObject) -> int:
     """A multibody with one link per material mesh, scaled to the instance's (w, d, h)."""
     mesh = o.mesh
     assert isinstance(mesh, MeshModel)

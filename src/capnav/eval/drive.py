@@ -1,4 +1,6 @@
-"""One instruction end to end: retrieve the described object, plan to it, drive there, draw it.
+"""One instruction end to end in the simulator: retrieve the described object, plan to it, drive
+the simulated agent there, draw it (``capnav navigate`` and the demo). It lives beside the
+evaluation because it drives the simulator and reads episode files; the stages it calls do not.
 
 The pipeline sees the map only; the simulator is the world the agent drives in (its obstacles
 are read only when the caller asks to plan on the true occupancy, for comparison).
