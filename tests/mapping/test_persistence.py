@@ -94,11 +94,11 @@ def _feed(mem, track_id: int, pts: np.ndarray, frames: range, label: str = "chai
 
 
 def test_merge_duplicates_unit() -> None:
-    from capnav.mapping import ObjectMemory
+    from capnav.mapping import MemoryConfig, ObjectMemory
 
     rng = np.random.default_rng(0)
     cube = rng.uniform(0, 0.5, (300, 3))
-    mem = ObjectMemory()
+    mem = ObjectMemory(MemoryConfig(same_overlap=1.1))  # the label and co-visibility rules alone
     a = _feed(mem, 1, cube, range(0, 3))
     b = _feed(mem, 2, cube + 0.01, range(10, 13), busy=[a])  # forced apart: seen "with" a
     c = _feed(mem, 3, cube + np.array([3.0, 0, 0]), range(20, 23))  # far away: distinct
@@ -112,6 +112,20 @@ def test_merge_duplicates_unit() -> None:
     objs = mem.export()
     assert [o.id for o in objs] == [1, 2, 3, 4]  # renumbered densely
     assert sum(o.label == "bed" for o in objs) == 1
+    # By default, objects whose points coincide (>= same_overlap) are one thing whatever their
+    # labels and co-visibility: a real detector's chair seen as 'bed' too, a part inside its whole.
+    mem = ObjectMemory()
+    ids = [_feed(mem, 1, cube, range(0, 3))]
+    ids.append(_feed(mem, 2, cube + 0.01, range(10, 13), busy=ids))
+    ids.append(_feed(mem, 3, cube + np.array([3.0, 0, 0]), range(20, 23)))
+    ids.append(_feed(mem, 4, cube, range(30, 33), label="bed", busy=ids))
+    ids.append(_feed(mem, 5, cube[:150], range(0, 3), busy=ids))  # half of it, co-visible with the first
+    assert len(set(ids)) == 5
+    assert mem.merge_duplicates() == 3
+    objs = mem.export()
+    assert len(objs) == 2
+    one = max(objs, key=lambda o: o.hits)
+    assert one.label == "chair" and set(one.label_votes) == {"chair", "bed"} and one.hits == 12
 
 
 def test_recheck_moves_a_neighbours_detection_to_its_own_object() -> None:

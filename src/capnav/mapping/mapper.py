@@ -1,5 +1,6 @@
-"""The mapping pipeline: frame -> detections + dense features -> voxel fusion (eq. 4-8) and
-lifted detections -> SG3DTracker (Algorithm 1) -> persistent objects -> ``CapNavMap``."""
+"""The mapping pipeline: frame -> detections (overlaps of one thing merged, ``frame_merge``) + dense
+features -> voxel fusion (eq. 4-8) and lifted detections -> SG3DTracker (Algorithm 1) -> persistent
+objects -> ``CapNavMap``."""
 
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ from capnav.core.errors import FrameError, InputError
 from capnav.core.frame import Frame
 from capnav.core.progress import track
 from capnav.mapping.cmap import CameraTrajectory, CapNavMap
+from capnav.mapping.frame_merge import FrameMergeConfig, merge_frame_detections
 from capnav.mapping.lifting import LiftConfig, LiftedDetection, lift_detection
 from capnav.mapping.memory import MemoryConfig, ObjectMemory
 from capnav.mapping.objects import Observation
@@ -47,6 +49,7 @@ class MapperConfig:
     memory: MemoryConfig = field(default_factory=MemoryConfig)
     occupancy: OccupancyConfig = field(default_factory=OccupancyConfig)
     lift: LiftConfig = field(default_factory=LiftConfig)
+    frame_merge: FrameMergeConfig = field(default_factory=FrameMergeConfig)
     on_bad_frame: Literal["skip", "raise"] = "skip"
     max_invalid_depth: float = 0.98
     max_pose_jump: float = 1.5  # m between consecutive frames; larger jumps are reported, not skipped
@@ -81,6 +84,7 @@ class Mapper:
         self.skipped: list[dict[str, Any]] = []
         self.detector_errors: dict[str, dict[str, Any]] = {}
         self.lift_skips = 0
+        self.frame_merges = 0
         self.pose_jumps: list[dict[str, Any]] = []
         self._last_eye: NDArray[np.float64] | None = None
         self.camera_path: list[tuple[int, NDArray[np.float64]]] = []  # (frame index, T_wc) of every frame fused
@@ -120,6 +124,8 @@ class Mapper:
             raise needs_truth_error(self.detector, f"frame {frame.index}")  # a stream of real frames
         try:
             dets = validate_detections(frame, self.detector.detect(frame))
+            dets, n_merged = merge_frame_detections(dets, self.config.frame_merge)
+            self.frame_merges += n_merged
         except Exception as e:  # any detector failure: the frame's geometry still counts
             if self.config.on_bad_frame == "raise":
                 raise
@@ -194,6 +200,7 @@ class Mapper:
             "detections_without_depth": self.lift_skips,
             "tracks": self.tracker._next_id - 1,
             "merged_duplicates": merged,
+            "merged_in_frame": self.frame_merges,
             "relinked_detections": self.memory.relinks,
             "detector": self.detector.id,
             "encoder": self.encoder.id,

@@ -31,7 +31,11 @@ class MemoryConfig:
     ``min_overlap`` of its points lie within ``overlap_radius`` of the other's points, or
     ``min_inside`` of them inside the other's box grown by ``overlap_radius``, and labels are
     compatible (equal, in one confusion group, or descriptor cosine >= ``min_cos``). Objects seen
-    together in more than ``max_covisible`` frames are distinct and never merged.
+    together in more than ``max_covisible`` frames are distinct and never merged, unless they are
+    one thing: at least ``same_overlap`` of the smaller one's points lie within ``overlap_radius``
+    of the other's (a part inside its whole, or one object mapped twice under two labels by a
+    real detector); those merge at export whatever their labels, the label votes summed (> 1
+    turns this off).
 
     ``recheck``: eq. 12 can hand a track the detection of a same-class neighbour when the right
     object is missed in that frame (0.8 m apart costs 0.68 < tau). A detection of a linked track
@@ -53,6 +57,7 @@ class MemoryConfig:
     recheck_margin: float = 0.15
     recheck_inside: float = 0.2
     recheck_min_points: int = 50
+    same_overlap: float = 0.6
     seed: int = 0
 
     def __post_init__(self) -> None:
@@ -186,7 +191,8 @@ class ObjectMemory:
     def _add(self, obj: _ObjectState, det: LiftedDetection, obs: Observation, frame: int) -> None:
         cfg = self.config
         w = float(det.detection.score)
-        obj.votes[det.detection.label] = obj.votes.get(det.detection.label, 0.0) + w
+        for label, v in det.detection.label_votes().items():
+            obj.votes[label] = obj.votes.get(label, 0.0) + v
         obj.feature = ((obj.feature * obj.feature_weight + det.descriptor * w) / (obj.feature_weight + w)).astype(
             np.float32)
         obj.feature_weight += w
@@ -256,6 +262,12 @@ class ObjectMemory:
 
     def _pair_score(self, oa: _ObjectState, ob: _ObjectState) -> float:
         cfg = self.config
+        small, big = (oa, ob) if len(oa.points) <= len(ob.points) else (ob, oa)
+        if cfg.same_overlap <= 1.0 and len(small.points) and len(big.points):
+            d, _ = cKDTree(big.points).query(small.points, distance_upper_bound=cfg.overlap_radius)
+            near = float(np.isfinite(d).mean())
+            if near >= cfg.same_overlap:  # one thing, whatever the labels and however often seen together
+                return 1.0 + near
         if len(oa.frames & ob.frames) > cfg.max_covisible:
             return 0.0
         if not (labels_compatible(oa.label, ob.label) or self._cos(oa, ob) >= cfg.min_cos):

@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
+from capnav.core.categories import BY_NAME
 from capnav.core.errors import InputError
 from capnav.mapping.cost import association_cost
 from capnav.mapping.lifting import LiftedDetection
@@ -101,6 +102,14 @@ class Track:
         self.label = self.labels[self.class_id]
 
 
+def vote_all(t: Track, d: LiftedDetection) -> None:
+    """Vote for every label the detection stands for (``Detection.label_votes``: several when
+    overlapping detections of one thing were merged)."""
+    for label, score in d.detection.label_votes().items():
+        cat = BY_NAME.get(label)
+        t.vote(d.class_id if label == d.detection.label else (cat.id if cat else 0), label, score)
+
+
 @dataclass
 class TrackerStep:
     """What one update did: matches (track, detection index), births, deaths, exported tracks."""
@@ -163,7 +172,7 @@ class SG3DTracker:
             t.velocity = v * (cfg.max_speed / speed) if speed > cfg.max_speed else v
             t.box = (1 - cfg.alpha_bbox) * t.box + cfg.alpha_bbox * np.asarray(d.box, dtype=np.float64)
             t.feature = ((1 - cfg.alpha_sem) * t.feature + cfg.alpha_sem * d.descriptor).astype(np.float32)
-            t.vote(d.class_id, d.detection.label, d.detection.score)
+            vote_all(t, d)
             t.hits += 1
             t.misses = 0
             t.age += 1
@@ -188,7 +197,7 @@ class SG3DTracker:
                       velocity=np.zeros(3), box=np.asarray(d.box, dtype=np.float64).copy(),
                       feature=np.asarray(d.descriptor, dtype=np.float32).copy(), class_id=d.class_id,
                       label=d.detection.label, last_update=self.step)
-            t.vote(d.class_id, d.detection.label, d.detection.score)
+            vote_all(t, d)
             self._next_id += 1
             survivors.append(t)
             births.append((t, i))

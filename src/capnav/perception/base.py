@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -27,13 +27,19 @@ Box = tuple[float, float, float, float]
 @dataclass
 class Detection:
     """One detection of eq. 9: ``box`` xyxy pixels, ``class_id`` (vocabulary id, 0 = unknown),
-    ``label`` text, ``score`` in [0, 1] and the instance ``mask`` (H, W) bool."""
+    ``label`` text, ``score`` in [0, 1] and the instance ``mask`` (H, W) bool; ``votes`` holds the
+    labels of overlapping detections of the same thing merged into it (``mapping.frame_merge``)."""
 
     box: Box
     class_id: int
     label: str
     score: float
     mask: NDArray[np.bool_]
+    votes: dict[str, float] = field(default_factory=dict)  # label -> score of detections merged into this one
+
+    def label_votes(self) -> dict[str, float]:
+        """Scores per label this detection stands for: its own, plus those merged into it."""
+        return dict(self.votes) if self.votes else {self.label: float(self.score)}
 
     @property
     def area(self) -> int:

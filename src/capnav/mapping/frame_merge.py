@@ -1,0 +1,85 @@
+"""One physical object, one detection: overlapping detections of a frame merged before tracking.
+
+A real detector reports one chair as the whole chair plus a part (an armrest box inside the
+chair's box), or twice under two labels (chair and toilet); per-class NMS keeps both, and each
+becomes a track and then a map object, so "the closest chair" may pick the duplicate. Masks tell
+what pixels each claims: two detections are one thing when their masks overlap by IoU >=
+``same_iou`` (any labels), or when the smaller mask lies at least ``part_inside`` inside the
+larger one and the labels are equal or lookalikes (``capnav.core.categories.confusable``: a
+chair's box inside a table's box is a chair at the table, not a part of it). The merged
+detection keeps the larger mask united with the smaller, the union box, the best score and the
+best-scoring label, and every label's score as ``votes`` for the tracker and the object memory.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from capnav.core.categories import confusable
+from capnav.core.errors import InputError
+from capnav.perception.base import Detection, box_from_mask
+
+
+@dataclass(frozen=True)
+class FrameMergeConfig:
+    """``same_iou``: mask IoU above which two detections are one thing whatever their labels;
+    ``part_inside``: share of the smaller mask inside the larger above which it is a part of it
+    (same or lookalike labels). ``enabled=False`` passes detections through."""
+
+    enabled: bool = True
+    same_iou: float = 0.6
+    part_inside: float = 0.85
+
+    def __post_init__(self) -> None:
+        if not (0.0 < self.same_iou <= 1.0 and 0.0 < self.part_inside <= 1.0):
+            raise InputError("same_iou and part_inside must be in (0, 1]")
+
+
+def _related(a: str, b: str) -> bool:
+    return a == b or b in confusable(a)
+
+
+def merge_frame_detections(dets: Sequence[Detection], cfg: FrameMergeConfig | None = None
+                           ) -> tuple[list[Detection], int]:
+    """Merge the detections of one frame that show one thing; returns (detections, merges)."""
+    cfg = cfg or FrameMergeConfig()
+    out = list(dets)
+    if not cfg.enabled or len(out) < 2:
+        return out, 0
+    merges = 0
+    changed = True
+    while changed:
+        changed = False
+        order = sorted(range(len(out)), key=lambda k: -out[k].area)
+        for ii, i in enumerate(order):
+            for j in order[ii + 1:]:
+                big, small = out[i], out[j]
+                inter = int((big.mask & small.mask).sum())
+                if inter == 0:
+                    continue
+                iou = inter / max(big.area + small.area - inter, 1)
+                inside = inter / max(small.area, 1)
+                if iou >= cfg.same_iou or (inside >= cfg.part_inside and _related(big.label, small.label)):
+                    out[i] = _combine(big, small)
+                    del out[j]
+                    merges += 1
+                    changed = True
+                    break
+            if changed:
+                break
+    return out, merges
+
+
+def _combine(a: Detection, b: Detection) -> Detection:
+    votes = a.label_votes()
+    for k, v in b.label_votes().items():
+        votes[k] = votes.get(k, 0.0) + v
+    lead = a if a.score >= b.score else b
+    mask = a.mask | b.mask
+    box = box_from_mask(mask)
+    ub = (min(a.box[0], b.box[0]), min(a.box[1], b.box[1]), max(a.box[2], b.box[2]), max(a.box[3], b.box[3]))
+    return Detection(ub if np.all(np.isfinite(ub)) else box, lead.class_id, lead.label, max(a.score, b.score),
+                     mask, votes)
