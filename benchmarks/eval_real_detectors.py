@@ -100,16 +100,16 @@ def main() -> None:
     ap.add_argument("--stride", type=int, default=1, help="map every k-th frame")
     args = ap.parse_args()
 
-    from sh3d_data import dataset
-
     from capnav.io.dataset import DatasetReader
     from capnav.mapping import build_map
     from capnav.mapping.quality import visible_frames
     from capnav.perception.coco import TO_CAPNAV
     from capnav.sim.manifest import SceneManifest
+    from sh3d_data import dataset
 
     cats = sorted(set(TO_CAPNAV.values()))
-    counts: dict[str, dict[str, dict[str, float]]] = {d: defaultdict(lambda: defaultdict(float)) for d in args.detectors}
+    counts: dict[str, dict[str, dict[str, float]]] = {d: defaultdict(lambda: defaultdict(float))
+                                                      for d in args.detectors}
     sizes: dict[str, dict[str, list[float]]] = {d: defaultdict(list) for d in args.detectors}
     totals: dict[str, dict[str, float]] = {d: defaultdict(float) for d in args.detectors}
     for seed in args.seeds:
