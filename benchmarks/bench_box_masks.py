@@ -27,6 +27,7 @@ for _v in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_
     os.environ.setdefault(_v, "1")
 
 import argparse  # noqa: E402
+import importlib  # noqa: E402
 import time  # noqa: E402
 from collections import defaultdict  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -146,10 +147,9 @@ def main() -> None:
     ap.add_argument("--pad", type=float, default=0.05)
     ap.add_argument("--no-map", action="store_true", help="per-view figures only")
     args = ap.parse_args()
+    dataset = importlib.import_module("sh3d_data").dataset  # beside this script
 
     from capnav.io.dataset import DatasetReader
-    from sh3d_data import dataset
-
     view: dict[str, dict[str, list[float]]] = defaultdict(lambda: defaultdict(list))
     sizes: dict[str, dict[str, list[float]]] = {m: defaultdict(list) for m in MASK_METHODS}
     secs = dict.fromkeys(MASK_METHODS, 0.0)

@@ -28,6 +28,7 @@ for _v in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_
     os.environ.setdefault(_v, "1")
 
 import argparse  # noqa: E402
+import importlib  # noqa: E402
 import time  # noqa: E402
 from collections import defaultdict  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -99,14 +100,14 @@ def main() -> None:
     ap.add_argument("--detectors", nargs="+", default=["sim", *FOLDERS], choices=["sim", *FOLDERS])
     ap.add_argument("--stride", type=int, default=1, help="map every k-th frame")
     args = ap.parse_args()
+    dataset = importlib.import_module("sh3d_data").dataset  # beside this script
+
+    from capnav.mapping.quality import visible_frames
 
     from capnav.io.dataset import DatasetReader
     from capnav.mapping import build_map
-    from capnav.mapping.quality import visible_frames
     from capnav.perception.coco import TO_CAPNAV
     from capnav.sim.manifest import SceneManifest
-    from sh3d_data import dataset
-
     cats = sorted(set(TO_CAPNAV.values()))
     counts: dict[str, dict[str, dict[str, float]]] = {d: defaultdict(lambda: defaultdict(float))
                                                       for d in args.detectors}
