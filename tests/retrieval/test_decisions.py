@@ -160,3 +160,14 @@ def test_the_room_with_a_landmark_is_the_landmarks_region(retriever):
     res = ask(retriever, "the armchair in the room with the bookshelf", relation="in the room with",
               anchor_category="bookshelf", anchor_phrase="bookshelf")
     assert res.found and res.chosen.label == "armchair"
+
+
+def test_an_alternative_does_not_serve_a_bare_name_whose_category_is_absent(retriever):
+    # No dining table and no ottoman in the flat: the coffee table or a stool must not stand in.
+    assert not ask(retriever, "the dining table", category="table", category_alternatives={"coffee table": 0.8}).found
+    assert not ask(retriever, "take me to the pouf", category="ottoman", category_alternatives={"stool": 0.5}).found
+    assert not ask(retriever, "the round table", category="table", shapes=["round"],
+                   category_alternatives={"coffee table": 0.8}).found
+    # With an observed attribute the alternative may serve.
+    res = ask(retriever, "the brown table", category="table", category_alternatives={"coffee table": 0.8})
+    assert res.found and res.chosen.id == 17
