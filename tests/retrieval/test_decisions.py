@@ -171,3 +171,5 @@ def test_an_alternative_does_not_serve_a_bare_name_whose_category_is_absent(retr
     # With an observed attribute the alternative may serve.
     res = ask(retriever, "the brown table", category="table", category_alternatives={"coffee table": 0.8})
     assert res.found and res.chosen.id == 17
+    # An unknown noun whose alternatives the map has is not served by them either.
+    assert not ask(retriever, "the harpsichord", category=None, category_alternatives={"stool": 0.4}).found

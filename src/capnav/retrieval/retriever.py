@@ -198,8 +198,7 @@ class Retriever:
             pool = np.arange(n)
             weights = np.ones(n)
         refusal: str | None = None
-        if q.category is not None and q.purpose is None and cfg.use_type_filter and len(pool) \
-                and not (weights[pool] >= 1.0).any():
+        if named and q.purpose is None and cfg.use_type_filter and len(pool) and not (weights[pool] >= 1.0).any():
             # No instance of the named category: an alternative serves only a request whose observed
             # attributes or landmark it shows ("the round wooden table" -> a round coffee table),
             # never a bare name ("the desk" is not the kitchen table). A purpose names several.
@@ -207,7 +206,7 @@ class Retriever:
                 pool = np.array([i for i in pool if all(w.lower() in (self.objects[i].caption or "").lower()
                                                         for w in q.shapes)], dtype=np.intp)
             if not (q.colors or q.shapes or q.anchor_category) or not len(pool):
-                refusal = (f"no {q.category} in the map, and nothing else fits "
+                refusal = (f"no {q.category or q.target_phrase} in the map, and nothing else fits "
                            f"'{q.target_phrase}' by what was observed")
         if q.negations and len(pool):
             neg = {int(i): self._negated(q, int(i)) for i in pool}
