@@ -20,7 +20,9 @@ from capnav.core.categories import NAMES
 from capnav.core.grid import FREE, OCCUPIED, GridSpec, OccupancyGrid
 from capnav.language import SceneContext, create_embedder, describe_map
 from capnav.language.colors import LEXICON
+from capnav.language.lexicon import load_lexicon
 from capnav.language.offline_captioner import ObservationCaptioner
+from capnav.language.purpose import gloss_index
 from capnav.mapping.cmap import CapNavMap
 from capnav.mapping.objects import MapObject
 from capnav.mapping.voxel_map import VoxelMap
@@ -57,7 +59,8 @@ def synthetic_map(n: int, seed: int) -> CapNavMap:
 def instructions(n: int, seed: int) -> list[tuple[str, tuple[float, float] | None]]:
     rng = np.random.default_rng(seed)
     forms = ["go to the {c} {n}", "the biggest {n}", "the {n} next to the {m}", "the {n} in the kitchen",
-             "closest {n}", "please find the {n}", "the {c} {n} in the bedroom", "the {n}"]
+             "closest {n}", "please find the {n}", "the {c} {n} in the bedroom", "the {n}",
+             "the {n} closest to the {m}", "not the {c} one, the {n}", "somewhere to sit", "the second closest {n}"]
     cols = list(LEXICON)
     out = []
     for k in range(n):
@@ -79,6 +82,9 @@ def main() -> None:
     ap.add_argument("--queries", type=int, default=200)
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
+    t = time.perf_counter()
+    lex = load_lexicon()  # what the first parse of a process pays (the parser module loads it on import)
+    t_lex = time.perf_counter() - t
     cmap = synthetic_map(args.objects, args.seed)
     emb = create_embedder("minilm", threads=1)
 
@@ -101,6 +107,9 @@ def main() -> None:
     r = Retriever(cmap, emb, create_verifier("offline"), RetrievalConfig())
     t_init = time.perf_counter() - t
 
+    t = time.perf_counter()
+    gloss_index(emb)  # the first request by purpose pays the glosses' embeddings, once per embedder
+    t_gloss = time.perf_counter() - t
     qs = instructions(args.queries, args.seed)
     parts: dict[str, list[float]] = {"embed": [], "rank": [], "verify": [], "total": []}
     found = 0
@@ -139,6 +148,8 @@ def main() -> None:
     print(f"{'MiniLM int8 embeddings (batch)':34s} {n / t_emb:9.0f} emb/s {'':>26s}")
     print(f"{'describe_map (no views)':34s} {t_describe * 1e3:11.0f} ms {'':>26s}")
     print(f"{'retriever init':34s} {t_init * 1e3:11.0f} ms {'':>26s}")
+    print(f"{'WordNet lexicon load (once)':34s} {max(t_lex, lex.load_seconds) * 1e3:11.1f} ms {'':>26s}")
+    print(f"{'purpose glosses embedded (once)':34s} {t_gloss * 1e3:11.0f} ms {'':>26s}")
     for k in ("embed", "rank", "verify", "total"):
         print(f"{'query ' + k + ' p50 / p95':34s} {pct(parts[k], 50):5.1f} /{pct(parts[k], 95):5.1f} ms"
               + (f" {'target p95 <= 50 ms':>26s}" if k == "total" else ""))
