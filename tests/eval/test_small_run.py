@@ -39,6 +39,7 @@ def test_run_folder_and_scoring(run: tuple[Path, object]) -> None:
     assert len(records) == len(DEFAULT_METHODS) * 2 * 2 * 4
     for r in records:
         assert r.success == (r.distance_to_goal <= 1.0)
+        assert r.success_strict is not None and (not r.success_strict or r.success)  # strict implies success
         assert math.isfinite(r.shortest_path)
         if r.index == 0:  # the first goal is never reached at the start
             assert r.shortest_path >= 1.0 - 1e-9
@@ -52,6 +53,7 @@ def test_run_folder_and_scoring(run: tuple[Path, object]) -> None:
         (m, p) for m in DEFAULT_METHODS for p in ("label", "description")}
     report = (out / "report.md").read_text()
     assert "Table 1" in report and "62 / 40 / 22 / 14" in report and "Description protocol" in report
+    assert "Strict indep." in report and results["summaries"][0]["independent_strict"] is not None
 
 
 def test_rerun_from_episode_files_is_identical(run: tuple[Path, object], tmp_path: Path) -> None:
@@ -61,6 +63,48 @@ def test_rerun_from_episode_files_is_identical(run: tuple[Path, object], tmp_pat
     a = [{k: v for k, v in r.to_dict().items() if k not in strip} for r in res.records]  # type: ignore[attr-defined]
     b = [{k: v for k, v in r.to_dict().items() if k not in strip} for r in again.records]
     assert a == b
+
+
+def test_phrasing_protocol_from_a_file(run: tuple[Path, object], tmp_path: Path) -> None:
+    """Instructions of the shared file format: a present target, one with a robot position, an
+    absent one (success = refusal), and a malformed line that names its line number."""
+    from capnav.eval.phrasings import load_phrasings
+    from capnav.sim import Simulator
+
+    with Simulator.from_seed(4000, CFG.pipeline.sim_config()) as sim:
+        objs = sim.manifest.objects
+    counts: dict[str, int] = {}
+    for o in objs:
+        counts[o.category] = counts.get(o.category, 0) + 1
+    single = next(o for o in objs if counts[o.category] == 1)
+    x, y = float(single.center[0]) + 2.0, float(single.center[1])
+    lines = [{"seed": 4000, "instruction": f"go to the {single.category}", "robot": None, "kind": "category",
+              "accept_ids": [single.id]},
+             {"seed": 4000, "instruction": f"the {single.category} please", "robot": [x, y], "kind": "category",
+              "accept_ids": [single.id]},
+             {"seed": 4000, "instruction": "take me to the grand piano", "robot": None, "kind": "absent",
+              "accept_ids": []}]
+    f = tmp_path / "mine.jsonl"
+    f.write_text("".join(json.dumps(d) + "\n" for d in lines))
+    es = load_phrasings(f)
+    assert [e.start is None for e in es.episodes] == [True, False, True]
+    cfg = EvalConfig(scenes=1, seed=4, methods=("capnav", "random-object"), protocols=("phrasing",),
+                     pipeline=CFG.pipeline)
+    res = run_benchmark(cfg, tmp_path / "p", workers=1, progress=False, episode_sets={"phrasing": es})
+    recs = {(r.method, r.episode_id): r for r in res.records}
+    assert len(recs) == 6
+    absent = recs[("capnav", "phrasing-0003")]
+    assert absent.success == (not absent.found) and absent.target_ids == []
+    assert recs[("capnav", "phrasing-0002")].start_xy == pytest.approx((x, y), abs=1e-6)
+    saved = json.loads((tmp_path / "p" / "episodes" / "phrasing.json").read_text())
+    assert all(e["start"] is not None for e in saved["episodes"])  # drawn starts are kept for reruns
+    report = (tmp_path / "p" / "report.md").read_text()
+    assert "Free phrasings" in report and "| absent | 1 |" in report
+    bad = tmp_path / "bad.jsonl"
+    bad.write_text(json.dumps(lines[0]) + "\n" + '{"seed": 4000, "robot": null}\n')
+    p = _cli("--instructions", str(bad), "--out", str(tmp_path / "o"), "--no-progress")
+    assert p.returncode == 2 and "bad.jsonl:2: instruction: Field required" in " ".join(p.stderr.split())
+    assert "Traceback" not in p.stderr
 
 
 def _cli(*args: str) -> subprocess.CompletedProcess[str]:
@@ -78,3 +122,5 @@ def test_cli_bad_input(tmp_path: Path) -> None:
     assert p.returncode == 2 and "unknown method(s) teleport" in p.stderr
     p = _cli("--protocols", "label,vibes", "--out", str(tmp_path / "o"), "--no-progress")
     assert p.returncode == 2 and "unknown protocol 'vibes'" in p.stderr
+    p = _cli("--protocols", "phrasing", "--out", str(tmp_path / "o"), "--no-progress")
+    assert p.returncode == 2 and "--instructions" in p.stderr

@@ -34,6 +34,9 @@ def register(app: typer.Typer) -> None:
         max_steps: Annotated[int, typer.Option(min=1, help="action budget per subgoal of the exploring methods")
                              ] = 200,
         progress: Annotated[bool, typer.Option(help="show progress")] = True,
+        instructions: Annotated[Path | None, typer.Option(
+            help="run the free-phrasing protocol from this JSONL file of hand-written instructions (seed, "
+                 "instruction, robot, kind, accept_ids) instead of generated episodes")] = None,
     ) -> None:
         """Run every method on the same apartments, maps and episodes; write results.json and report.md."""
         from rich.console import Console
@@ -49,15 +52,26 @@ def register(app: typer.Typer) -> None:
         else:
             names = tuple(m.strip() for m in methods.split(",") if m.strip())
         check_output_dir(out, "--out")  # a run folder may exist: finished apartments are reused
+        sets = {}
+        protos: tuple[str, ...]
+        if instructions is not None:
+            from capnav.eval.phrasings import load_phrasings
+
+            sets = {"phrasing": load_phrasings(instructions, seed)}
+            protos = ("phrasing",)
+        else:
+            protos = tuple(parse_protocols(protocols))
         cfg = EvalConfig(scenes=scenes, episodes_per_scene=episodes_per_scene, seed=seed, methods=names,
-                         protocols=tuple(parse_protocols(protocols)), pictures_per_scene=pictures, max_steps=max_steps,
+                         protocols=protos, pictures_per_scene=pictures, max_steps=max_steps,
                          pipeline=PipelineConfig(width=width, height=height, max_frames=max_frames))
         on_interrupt(f"workers stopped; finished apartments are kept in {out}/scenes (run the same command "
                      "again to resume from them)")
         res = run_benchmark(cfg, out, workers=workers, ray_address=ray, episodes_dir=episodes, progress=progress,
-                            command=" ".join(["capnav", *map(shlex.quote, sys.argv[1:])]))
+                            command=" ".join(["capnav", *map(shlex.quote, sys.argv[1:])]), episode_sets=sets)
         con = Console()
         for s in res.summaries:
             con.print(f"{s.method:>20} {s.protocol:>11}: in a row {' / '.join(f'{100 * v:.0f}' for v in s.in_a_row)}"
-                      f", indep. {100 * s.independent:.1f}%, SPL {100 * s.spl:.1f}")
+                      f", indep. {100 * s.independent:.1f}%, SPL {100 * s.spl:.1f}"
+                      + (f", strict indep. {100 * s.independent_strict:.1f}%" if s.independent_strict is not None
+                         else ""))
         con.print(f"{len(res.records)} subgoals in {res.seconds:.0f} s; report: {res.out / 'report.md'}")

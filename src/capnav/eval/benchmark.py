@@ -75,8 +75,11 @@ def load_episode_dir(path: Path, protocols: tuple[str, ...]) -> dict[str, Episod
 
 
 def run_benchmark(config: EvalConfig, out: str | Path, workers: int = 1, ray_address: str | None = None,
-                  episodes_dir: str | Path | None = None, progress: bool = True, command: str = "") -> BenchmarkResult:
-    """Evaluate ``config.methods`` on both protocols over ``config.scenes`` apartments."""
+                  episodes_dir: str | Path | None = None, progress: bool = True, command: str = "",
+                  episode_sets: dict[str, EpisodeSet] | None = None) -> BenchmarkResult:
+    """Evaluate ``config.methods`` on ``config.protocols`` over ``config.scenes`` apartments, or on
+    the apartments of given episodes (``episodes_dir`` files, or ``episode_sets`` such as a
+    ``phrasing`` set read by ``capnav.eval.phrasings.load_phrasings``)."""
     t0 = time.perf_counter()
     out = Path(out)
     known = load_methods()
@@ -87,25 +90,34 @@ def run_benchmark(config: EvalConfig, out: str | Path, workers: int = 1, ray_add
     scene_seeds = config.scene_seeds()
     if episodes_dir is not None:
         given = load_episode_dir(Path(episodes_dir), config.protocols)
+    given.update(episode_sets or {})
+    missing = [p for p in given if p not in config.protocols]
+    if missing:
+        raise InputError(f"episodes given for protocol(s) {', '.join(missing)} that the run does not include")
+    if given:
         scene_seeds = sorted({s for es in given.values() for s in es.scene_seeds})
     version, commit = _version()
     meta = {"version": version, "commit": commit, "seed": config.seed, "scenes": len(scene_seeds),
             "scene_seeds": scene_seeds, "episodes_per_scene": config.episodes_per_scene,
             "detector": f"{config.pipeline.detector}:{config.pipeline.detector_noise}",
             "embedder": config.pipeline.embedder, "command": command or "capnav eval", "workers": workers,
+            "instructions": next((str(es.generator.get("instructions")) for es in given.values()
+                                  if "instructions" in es.generator), None),
             "ray": ray_address, "config": asdict(config)}
     write_json(out / "config.json", meta)
     tasks = [SceneTask(config, s, str(out), {p: [e.model_dump() for e in es.for_scene(s)] for p, es in given.items()}
                        or None) for s in scene_seeds]
     results = run_tasks(run_scene, tasks, workers=workers, ray_address=ray_address, progress=progress)
 
-    if not given:  # save the generated episodes so that anyone can rerun exactly
-        for p in config.protocols:
-            es = EpisodeSet(protocol=p, seed=config.seed, scene_seeds=scene_seeds,  # type: ignore[arg-type]
-                            generator={"episodes_per_scene": config.episodes_per_scene, "subgoals": config.subgoals,
-                                       "version": version},
-                            episodes=[e for res in results for e in res["episodes"][p]])
-            es.save(out / "episodes" / f"{p}.json")
+    # Save the episodes as run (generated ones, and given ones with their drawn starts) so that
+    # anyone can rerun exactly with --episodes OUT/episodes.
+    for p in config.protocols:
+        gen = given[p].generator if p in given else {}
+        es = EpisodeSet(protocol=p, seed=config.seed, scene_seeds=scene_seeds,  # type: ignore[arg-type]
+                        generator={"episodes_per_scene": config.episodes_per_scene, "subgoals": config.subgoals,
+                                   "version": version, **gen},
+                        episodes=[e for res in results for e in res["episodes"][p]])
+        es.save(out / "episodes" / f"{p}.json")
 
     records = [SubgoalRecord.from_dict(d) for res in results for d in res["records"]]
     write_text(out / "records.jsonl", "".join(json.dumps({k: v for k, v in r.to_dict().items()

@@ -71,6 +71,8 @@ def episode_start(path: str | Path, episode_id: str | None = None) -> tuple[int,
         ids = ", ".join(e.id for e in eps[:8])
         raise InputError(f"no episode {episode_id!r} in {path} (first ids: {ids})")
     e = match[0]
+    if e.start is None:
+        raise InputError(f"episode {e.id} of {path} has no start pose; give --start X,Y,YAW")
     return e.scene_seed, (e.start.x, e.start.y, e.start.yaw)
 
 

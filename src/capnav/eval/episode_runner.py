@@ -60,6 +60,8 @@ def run_episode(method: NavMethod, ctx: SceneContext, episode: Episode, truth: S
                 ) -> list[SubgoalRecord]:
     """Spawn the agent at the episode's start, run the subgoals in order, score each."""
     s = episode.start
+    if s is None:
+        raise CapNavError(f"episode {episode.id} has no start pose (fill it with eval.phrasings.fill_start)")
     agent = ctx.sim.spawn_agent(s.x, s.y, s.yaw)
     broken = ""
     try:
@@ -89,15 +91,25 @@ def run_episode(method: NavMethod, ctx: SceneContext, episode: Episode, truth: S
         stop_xy = _xy(agent)
         footprints = [truth.footprints[t] for t in goal.target_ids]
         dist = distance_to_instances(stop_xy, footprints)
+        if goal.absent:  # the right answer is "not found": success is a refusal, wherever the agent is
+            success: bool = not out.found
+            strict: bool | None = success if truth.sight is not None else None
+            judged: bool | None = not out.found
+            shortest = 0.0
+        else:
+            success = bool(dist <= truth.radius)
+            strict = truth.sees_goal(stop_xy, goal.target_ids)
+            judged = retrieval_correct(truth, out.target_xy, goal.target_ids)
+            shortest = truth.field(goal.target_ids).at(start_xy)
         traj = _trajectory(agent)[max(traj0 - 1, 0):] or [start_xy, stop_xy]
         records.append(SubgoalRecord(
             method=method.name, protocol=protocol, scene_seed=episode.scene_seed, episode_id=episode.id, index=i,
             text=goal.text, category=goal.category, target_ids=list(goal.target_ids), kind=goal.kind,
-            success=bool(dist <= truth.radius), distance_to_goal=dist,
+            success=success, distance_to_goal=dist, success_strict=strict,
             path_length=max(_odometry(agent) - odo0, 0.0),
-            shortest_path=truth.field(goal.target_ids).at(start_xy),
+            shortest_path=shortest,
             start_xy=start_xy, stop_xy=stop_xy, found=bool(out.found),
-            retrieval_correct=retrieval_correct(truth, out.target_xy, goal.target_ids),
+            retrieval_correct=judged,
             query_time_s=float(out.query_time_s), steps=int(out.steps), reason=out.reason,
             target_xy=None if out.target_xy is None else (float(out.target_xy[0]), float(out.target_xy[1])),
             chosen_object=out.chosen_object, explanation=out.explanation,

@@ -21,8 +21,10 @@ from capnav.core.jsonfile import read_json_object
 
 EPISODES_FORMAT: Literal["capnav-episodes"] = "capnav-episodes"
 EPISODES_VERSION = 1
-PROTOCOLS: tuple[str, ...] = ("label", "description")
-Protocol = Literal["label", "description"]
+PROTOCOLS: tuple[str, ...] = ("label", "description", "phrasing")
+Protocol = Literal["label", "description", "phrasing"]
+#: Protocols generated from the apartments (``phrasing`` episodes come from a file of instructions).
+GENERATED_PROTOCOLS: tuple[str, ...] = ("label", "description")
 
 
 class StartPose(BaseModel):
@@ -35,22 +37,29 @@ class Subgoal(BaseModel):
     """One goal of an episode: what the method hears and what counts as reaching it."""
 
     text: str = Field(min_length=1)
-    category: str
-    target_ids: list[int] = Field(min_length=1, description="ground-truth instance ids that count as success")
-    kind: str = "category"  # instruction kind: category, attribute, superlative, relation, room, closest
+    category: str = Field(description="the goal's category; '' for a free phrasing (targets of any category)")
+    target_ids: list[int] = Field(description="ground-truth instance ids that count as success; empty when "
+                                              "the right answer is 'not found' (phrasing protocol only)")
+    kind: str = "category"  # instruction kind: category, attribute, superlative, relation, room, closest, ...
 
     @field_validator("category")
     @classmethod
     def _known_category(cls, v: str) -> str:
-        if v not in BY_NAME:
+        if v and v not in BY_NAME:
             raise ValueError(f"unknown category {v!r}; known: {', '.join(NAMES)}")
         return v
+
+    @property
+    def absent(self) -> bool:
+        """The right answer is 'not found': success is a refusal."""
+        return not self.target_ids
 
 
 class Episode(BaseModel):
     id: str
     scene_seed: int
-    start: StartPose
+    #: None: the harness draws a seeded navigable start (free phrasings that give no robot position).
+    start: StartPose | None = None
     subgoals: list[Subgoal] = Field(min_length=1)
 
 
@@ -74,10 +83,12 @@ class EpisodeSet(BaseModel):
         for e in self.episodes:
             if e.scene_seed not in known:
                 raise ValueError(f"episode {e.id} uses scene {e.scene_seed} not listed in scene_seeds")
-            if self.protocol == "description":
-                for i, g in enumerate(e.subgoals):
-                    if len(g.target_ids) != 1:
-                        raise ValueError(f"episode {e.id} subgoal {i}: a description goal has exactly one target")
+            for i, g in enumerate(e.subgoals):
+                if self.protocol == "description" and len(g.target_ids) != 1:
+                    raise ValueError(f"episode {e.id} subgoal {i}: a description goal has exactly one target")
+                if self.protocol != "phrasing" and (not g.target_ids or not g.category):
+                    raise ValueError(f"episode {e.id} subgoal {i}: a {self.protocol} goal needs a category and "
+                                     "at least one target")
         return self
 
     def for_scene(self, scene_seed: int) -> list[Episode]:
@@ -121,7 +132,7 @@ def check_against_manifest(episodes: Iterable[Episode], manifest: object) -> Non
             for t in g.target_ids:
                 if t not in objects:
                     raise DatasetError(f"episode {e.id} subgoal {i}: instance {t} is not in scene {e.scene_seed}")
-                if objects[t].category != g.category:
+                if g.category and objects[t].category != g.category:
                     raise DatasetError(f"episode {e.id} subgoal {i}: instance {t} is a {objects[t].category}, "
                                        f"not a {g.category}")
 
@@ -130,8 +141,10 @@ def parse_protocols(text: str | Iterable[str]) -> list[str]:
     """``"label,description"`` -> ["label", "description"]; unknown names are an ``InputError``."""
     items = [t.strip() for t in (text.split(",") if isinstance(text, str) else text) if t.strip()]
     for t in items:
-        if t not in PROTOCOLS:
-            raise InputError(f"unknown protocol {t!r}; choose from {', '.join(PROTOCOLS)}")
+        if t == "phrasing":
+            raise InputError("the phrasing protocol runs from a file of instructions: use --instructions FILE")
+        if t not in GENERATED_PROTOCOLS:
+            raise InputError(f"unknown protocol {t!r}; choose from {', '.join(GENERATED_PROTOCOLS)}")
     if not items:
         raise InputError("no protocol given")
     return items

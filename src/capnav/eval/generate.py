@@ -16,10 +16,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.core.errors import DatasetError, InputError
+from capnav.core.footprint import footprint_distance
 from capnav.core.grid import GridSpec
 from capnav.eval.episodes import Episode, StartPose, Subgoal
 from capnav.eval.geodesic import DistanceField, distance_field
 from capnav.eval.success import SUCCESS_RADIUS_M
+from capnav.sim.sightline import SightGrid
 
 
 @dataclass(frozen=True)
@@ -48,15 +50,28 @@ class SceneTruth:
     spec: GridSpec
     navigable: NDArray[np.bool_]
     radius: float = SUCCESS_RADIUS_M
+    sight: SightGrid | None = None  # walls and tall objects, for the strict (line-of-sight) success rule
     _fields: dict[tuple[int, ...], DistanceField] = field(default_factory=dict, repr=False)
 
     @classmethod
     def from_manifest(cls, manifest: object, spec: GridSpec, navigable: NDArray[np.bool_],
-                      radius: float = SUCCESS_RADIUS_M) -> SceneTruth:
+                      radius: float = SUCCESS_RADIUS_M, sight: SightGrid | None = None) -> SceneTruth:
         objs = manifest.objects  # type: ignore[attr-defined]
         return cls(int(manifest.seed), {o.id: o.category for o in objs},  # type: ignore[attr-defined]
                    {o.id: np.asarray(o.footprint, dtype=np.float64) for o in objs}, spec,
-                   np.asarray(navigable, dtype=bool), radius)
+                   np.asarray(navigable, dtype=bool), radius, sight)
+
+    def sees_goal(self, xy: tuple[float, float], target_ids: Sequence[int]) -> bool | None:
+        """Strict success's second half: is one of the goal instances within ``radius`` AND in sight
+        of ``xy``? None when this truth has no sight grid."""
+        if self.sight is None:
+            return None
+        for t in target_ids:
+            fp = self.footprints[t]
+            if footprint_distance(np.asarray(xy, dtype=np.float64).reshape(1, 2), fp)[0] <= self.radius \
+                    and self.sight.sees(xy, fp, own_ids=(t,)):
+                return True
+        return False
 
     def instances_of(self, category: str) -> list[int]:
         return sorted(i for i, c in self.categories.items() if c == category)

@@ -53,6 +53,9 @@ class SubgoalRecord:
     explanation: str = ""
     trajectory: list[tuple[float, float]] = field(default_factory=list)
     error: str = ""  # non-empty when the method crashed on this subgoal (scored as a failure)
+    #: Strict rule: within 1 m of a goal instance AND in sight of it (no wall or tall object between);
+    #: None for records made without the scene's sight grid.
+    success_strict: bool | None = None
 
     @property
     def spl(self) -> float:
@@ -107,6 +110,9 @@ class Summary:
     query_time_p50_s: float
     found_rate: float
     crashes: int = 0  # subgoals on which the method raised an unexpected exception
+    #: The same two figures under the strict rule (stopped within 1 m AND in sight); None without it.
+    in_a_row_strict: list[float] | None = None
+    independent_strict: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -125,14 +131,14 @@ def in_a_row(chains: Sequence[Sequence[bool]], max_k: int = MAX_CHAIN) -> list[f
     return out
 
 
-def chains_of(records: Iterable[SubgoalRecord]) -> list[list[bool]]:
+def chains_of(records: Iterable[SubgoalRecord], strict: bool = False) -> list[list[bool]]:
     """Per-episode success chains in subgoal order (records may come in any order)."""
     by_ep: dict[tuple[int, str], dict[int, bool]] = defaultdict(dict)
     for r in records:
         key = (r.scene_seed, r.episode_id)
         if r.index in by_ep[key]:
             raise InputError(f"episode {r.episode_id} has two records for subgoal {r.index}")
-        by_ep[key][r.index] = r.success
+        by_ep[key][r.index] = bool(r.success_strict) if strict else r.success
     chains = []
     for key in sorted(by_ep):
         d = by_ep[key]
@@ -151,6 +157,7 @@ def summarize(records: Sequence[SubgoalRecord]) -> Summary:
     if len(methods) != 1 or len(protocols) != 1:
         raise InputError(f"summarize one method and protocol at a time, got {methods} x {protocols}")
     chains = chains_of(records)
+    has_strict = all(r.success_strict is not None for r in records)
     judged = [r.retrieval_correct for r in records]
     times = np.array([r.query_time_s for r in records], dtype=np.float64)
     return Summary(
@@ -168,6 +175,8 @@ def summarize(records: Sequence[SubgoalRecord]) -> Summary:
         query_time_p50_s=float(np.median(times)),
         found_rate=float(np.mean([r.found for r in records])),
         crashes=sum(1 for r in records if r.error),
+        in_a_row_strict=in_a_row(chains_of(records, strict=True)) if has_strict else None,
+        independent_strict=float(np.mean([bool(r.success_strict) for r in records])) if has_strict else None,
     )
 
 

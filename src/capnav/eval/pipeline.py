@@ -12,6 +12,7 @@ from capnav.core.grid import FREE
 from capnav.eval.generate import SceneTruth
 from capnav.language.embedder import TextEmbedder
 from capnav.pipeline.simulated import MAP_FILE, FrameList, PipelineConfig, SimScene, build_scene_map, open_sim_scene
+from capnav.sim.sightline import sight_grid
 
 __all__ = ["MAP_FILE", "FrameList", "PipelineConfig", "SceneAssets", "build_scene_map", "open_scene"]
 
@@ -29,7 +30,8 @@ def open_scene(scene_seed: int, seed: int, config: PipelineConfig, folder: Path,
     scene = open_sim_scene(scene_seed, seed, config, folder, embedder)
     t0 = time.perf_counter()
     nav = scene.sim.navigable()
-    truth = SceneTruth.from_manifest(scene.sim.manifest, nav.spec, nav.cells == FREE)
+    truth = SceneTruth.from_manifest(scene.sim.manifest, nav.spec, nav.cells == FREE,
+                                     sight=sight_grid(scene.sim.apartment, nav.spec))
     timings = dict(scene.timings)
     timings["simulator"] = timings.get("simulator", 0.0) + time.perf_counter() - t0
     return SceneAssets(scene.scene_seed, scene.seed, scene.config, scene.sim, scene.embedder, scene.detector,

@@ -35,15 +35,20 @@ def _sorted(summaries: Sequence[Summary]) -> list[Summary]:
 
 
 def table1(summaries: Sequence[Summary], protocol: str = "label") -> list[str]:
-    """In-a-row success for 1..4 subgoals and independent success, paper numbers beside ours."""
-    lines = ["| Method | 1 | 2 | 3 | 4 | Indep. | SPL | Paper 1 / 2 / 3 / 4 | Paper indep. |",
-             "|---|---:|---:|---:|---:|---:|---:|---|---:|"]
+    """In-a-row success for 1..4 subgoals and independent success, under the paper's rule and the
+    strict one; the paper's numbers beside ours only for its own (label-only) protocol."""
+    paper_cols = protocol == "label"
+    lines = ["| Method | 1 | 2 | 3 | 4 | Indep. | SPL | Strict 1 / 2 / 3 / 4 | Strict indep. "
+             + ("| Paper 1 / 2 / 3 / 4 | Paper indep. |" if paper_cols else "|"),
+             "|---|---:|---:|---:|---:|---:|---:|---|---:|" + ("---|---:|" if paper_cols else "")]
     for s in _sorted([s for s in summaries if s.protocol == protocol]):
         p = paper_row(s.method)
         paper = " / ".join(f"{v:g}" for v in p.in_a_row) if p else "–"
         paper_ind = f"{p.independent:g}" if p else "–"
         row = " | ".join(_pct(v) for v in s.in_a_row)
-        lines.append(f"| {s.method} | {row} | {_pct(s.independent)} | {_pct(s.spl)} | {paper} | {paper_ind} |")
+        strict = " / ".join(_pct(v) for v in s.in_a_row_strict) if s.in_a_row_strict else "–"
+        lines.append(f"| {s.method} | {row} | {_pct(s.independent)} | {_pct(s.spl)} | {strict} "
+                     f"| {_pct(s.independent_strict)} |" + (f" {paper} | {paper_ind} |" if paper_cols else ""))
     return lines
 
 
@@ -59,6 +64,25 @@ def table2(summaries: Sequence[Summary]) -> list[str]:
             continue
         cells = [_pct(s.in_a_row[-1] if s else None) + " | " + _pct(s.independent if s else None) for s in (lab, des)]
         lines.append(f"| {name} ({label}) | {cells[0]} | {cells[1]} | {psr:.1f} | {psub:.1f} |")
+    return lines
+
+
+def by_kind(records: Sequence[SubgoalRecord], protocol: str = "phrasing") -> list[str]:
+    """Success per instruction kind and method (the phrasing protocol's kinds come from its file)."""
+    recs = [r for r in records if r.protocol == protocol]
+    methods = [m for m in dict.fromkeys(r.method for r in recs)]
+    methods.sort(key=lambda m: (ORDER.index(_key(m)) if _key(m) in ORDER else len(ORDER), m))
+    kinds = sorted({r.kind for r in recs})
+    lines = ["| Kind | n | " + " | ".join(methods) + " |", "|---|---:|" + "---:|" * len(methods)]
+    for k in kinds:
+        cells = []
+        for m in methods:
+            rs = [r for r in recs if r.method == m and r.kind == k]
+            ok = sum(r.success for r in rs)
+            strict = sum(bool(r.success_strict) for r in rs)
+            cells.append(f"{ok}/{len(rs)} ({strict} strict)")
+        n = len([r for r in recs if r.kind == k and r.method == methods[0]])
+        lines.append(f"| {k} | {n} | " + " | ".join(cells) + " |")
     return lines
 
 
@@ -92,13 +116,25 @@ def render(summaries: Sequence[Summary], config: Mapping[str, Any],
                "Detic + LSeg + Gemini + BGE-M3. Ours: procedural apartments in pybullet, a simulated detector "
                "with a noise model, offline captions and a MiniLM embedder. Compare methods within a table; "
                "absolute numbers are not comparable across the two setups.")
+    out += ["", "Success is the paper's rule (the agent stops within 1 m of a goal instance's footprint); "
+            "*strict* also asks that it sees the object: a straight line from the stop point to the "
+            "footprint that no wall and no object 1 m or taller crosses (`capnav.sim.sightline`).", ""]
     out += ["", "## Table 1: multi-object navigation, label-only protocol (success %, in a row)", ""]
     out += table1(summaries, "label")
     out += ["", "## Table 2: ablations (full-chain success rate and subgoal success rate, %)", ""]
     out += table2(summaries)
     out += ["", "## Description protocol: reach the one described instance among lookalikes (%)", "",
-            "Not in the paper (its 'Paper' columns repeat Table 1 for orientation only).", ""]
+            "Not in the paper, so no paper numbers beside it.", ""]
     out += table1(summaries, "description")
+    if any(s.protocol == "phrasing" for s in summaries):
+        out += ["", "## Free phrasings: hand-written instructions (success %)", "",
+                f"Instructions from `{config.get('instructions', 'a file')}`, one subgoal each, judged like the "
+                "description protocol; an absent target succeeds when the method answers 'not found'. "
+                "The 'in a row' columns equal the independent figure here.", ""]
+        out += table1(summaries, "phrasing")
+        if records:
+            out += ["", "Successes per kind (paper rule, with the strict count):", ""]
+            out += by_kind(records, "phrasing")
     out += ["", "## Details", ""]
     out += details(summaries)
     if records:

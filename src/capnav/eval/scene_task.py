@@ -21,7 +21,7 @@ from capnav.core.atomic import write_json
 from capnav.core.errors import InputError
 from capnav.core.limits import check_count, check_seed
 from capnav.eval.episode_runner import run_episode
-from capnav.eval.episodes import PROTOCOLS, Episode, check_against_manifest
+from capnav.eval.episodes import GENERATED_PROTOCOLS, PROTOCOLS, Episode, check_against_manifest
 from capnav.eval.generate import EpisodeConfig, description_episodes, label_episodes
 from capnav.eval.method import SceneContext, create_method
 from capnav.eval.metrics import SubgoalRecord
@@ -43,7 +43,7 @@ class EvalConfig:
     episodes_per_scene: int = 9
     seed: int = 0
     methods: tuple[str, ...] = DEFAULT_METHODS
-    protocols: tuple[str, ...] = PROTOCOLS
+    protocols: tuple[str, ...] = GENERATED_PROTOCOLS
     subgoals: int = 4
     pipeline: PipelineConfig = field(default_factory=PipelineConfig)
     # Motion budget per subgoal for step-driven (exploring) methods: Habitat's ObjectNav allows 500
@@ -131,7 +131,11 @@ def _run(task: SceneTask, cfg: EvalConfig, out: Path, assets: SceneAssets) -> di
     for protocol in cfg.protocols:
         given = (task.episodes or {}).get(protocol)
         if given is not None:
-            episodes[protocol] = [Episode.model_validate(e) for e in given]
+            from capnav.eval.phrasings import fill_start
+
+            rng = np.random.default_rng([cfg.seed, assets.scene_seed, PROTOCOLS.index(protocol)])
+            episodes[protocol] = [fill_start(Episode.model_validate(e), assets.truth, rng, cfg.episode_config())
+                                  for e in given]
             check_against_manifest(episodes[protocol], assets.sim.manifest)
         else:
             episodes[protocol] = generate_scene_episodes(assets, cfg, protocol)
