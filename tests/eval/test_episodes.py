@@ -31,7 +31,7 @@ def test_roundtrip(tmp_path: Path) -> None:
     (lambda d: d.update(version=99), "version 99"),
     (lambda d: d.update(format="something"), "not a CapNav episode file"),
     (lambda d: d["episodes"][0]["subgoals"][0].update(target_ids=[]), "target_ids"),
-    (lambda d: d["episodes"][0].pop("start"), "episodes.0.start"),
+    (lambda d: d["episodes"][0].pop("start"), "needs a start pose"),
     (lambda d: d["episodes"][0].update(scene_seed=5), "scene 5 not listed"),
     (lambda d: d["episodes"].append(dict(d["episodes"][0])), "not unique"),
     (lambda d: d["episodes"][0]["subgoals"][0].update(target_ids=[3, 4]), "exactly one target"),

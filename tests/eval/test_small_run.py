@@ -124,3 +124,17 @@ def test_cli_bad_input(tmp_path: Path) -> None:
     assert p.returncode == 2 and "unknown protocol 'vibes'" in p.stderr
     p = _cli("--protocols", "phrasing", "--out", str(tmp_path / "o"), "--no-progress")
     assert p.returncode == 2 and "--instructions" in p.stderr
+    p = _cli("--detector", "x-ray", "--out", str(tmp_path / "o"), "--no-progress")
+    assert p.returncode == 2 and "unknown detector 'x-ray'" in " ".join(p.stderr.split())
+    p = _cli("--furniture", "ikea", "--out", str(tmp_path / "o"), "--no-progress")
+    assert p.returncode == 2 and "unknown furniture 'ikea'" in " ".join(p.stderr.split())
+
+
+def test_the_perception_track_is_named_and_part_of_the_map_key() -> None:
+    sim = PipelineConfig()
+    real = PipelineConfig(detector="yolo-fastest", furniture="sh3d", detector_options=(("score", 0.3),))
+    assert sim.track == "default houses, primitives furniture, sim:default detector"
+    assert real.track == "default houses, sh3d furniture, yolo-fastest detector"
+    assert PipelineConfig(size="large").sim_config().layout.min_rooms == 8
+    assert real.sim_config().furniture == "sh3d"
+    assert sim.map_key(0, 0) != real.map_key(0, 0)

@@ -112,7 +112,7 @@ def test_bad_seeds_and_room_counts_rejected() -> None:
         with pytest.raises(InputError):
             generate_apartment(bad, SimConfig())  # type: ignore[arg-type]
     with pytest.raises(InputError):
-        LayoutConfig(rooms=9)
+        LayoutConfig(rooms=17)
     with pytest.raises(InputError):
         LayoutConfig(rooms=2)
 
@@ -148,3 +148,29 @@ def test_placement_is_plausible(apt) -> None:  # type: ignore[no-untyped-def]
             beds = [b for b in apt.objects if b.category == "bed"]
             fp = RectSet.from_lists([(b.x, b.y) for b in beds], [b.model.size[:2] for b in beds], [b.yaw for b in beds])
             assert fp.min_distance(o.footprint()).min() < 0.1
+
+
+@pytest.mark.parametrize("seed", [0, 3])
+def test_the_large_house_preset(seed: int) -> None:
+    """Near Matterport scale: 8-14 rooms with hallways, 120-250 m2, 60-150 objects, at most 6 of a
+    kind, every object reachable (within 1 m of a navigable cell); the default preset is unchanged."""
+    from collections import Counter
+
+    from capnav.sim.config import house_config
+
+    cfg = house_config("large")
+    apt = generate_apartment(seed, cfg)
+    b = apt.plan.bounds
+    counts = Counter(o.category for o in apt.objects)
+    assert 8 <= len(apt.plan.rooms) <= 14 and "hallway" in apt.plan.types
+    assert 120 <= b.w * b.h <= 250
+    assert 60 <= len(apt.objects) <= 150
+    assert max(counts.values()) <= 6 and sum(v >= 4 for v in counts.values()) >= 3
+    grid = NavGrid(apt.obstacles(), apt.bounds, cfg.agent.radius, cfg.nav_resolution)
+    pts = grid.free_points()
+    for o in apt.objects:  # the agent's centre can get within REACH_RADIUS of the object's footprint
+        rs = RectSet.from_lists([(o.x, o.y)], [o.model.size[:2]], [o.yaw])
+        assert rs.min_distance(pts).min() <= REACH_RADIUS, (o.id, o.category)
+    assert house_config("default") == SimConfig()
+    with pytest.raises(InputError):
+        house_config("huge")

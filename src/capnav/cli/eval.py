@@ -34,6 +34,18 @@ def register(app: typer.Typer) -> None:
         max_steps: Annotated[int, typer.Option(min=1, help="action budget per subgoal of the exploring methods")
                              ] = 200,
         progress: Annotated[bool, typer.Option(help="show progress")] = True,
+        size: Annotated[str, typer.Option(
+            help="house size: default (3-7 rooms) or large (8-14 rooms, 60-150 objects, near Matterport scale)")
+                        ] = "default",
+        furniture: Annotated[str, typer.Option(
+            help="apartment furniture: primitives, or sh3d (Sweet Home 3D meshes, after `capnav assets`)")
+                             ] = "primitives",
+        detector: Annotated[str, typer.Option(
+            help="detector of every method: sim (with --noise), or a real one (yolo-fastest, centernet, owl)")
+                            ] = "sim",
+        noise: Annotated[str, typer.Option(help="sim detector noise: default, hard, oracle")] = "default",
+        detector_option: Annotated[list[str] | None, typer.Option(
+            "--detector-option", metavar="KEY=VALUE", help="setting of a real detector, repeatable")] = None,
         instructions: Annotated[Path | None, typer.Option(
             help="run the free-phrasing protocol from this JSONL file of hand-written instructions (seed, "
                  "instruction, robot, kind, accept_ids) instead of generated episodes")] = None,
@@ -52,6 +64,22 @@ def register(app: typer.Typer) -> None:
         else:
             names = tuple(m.strip() for m in methods.split(",") if m.strip())
         check_output_dir(out, "--out")  # a run folder may exist: finished apartments are reused
+        from capnav.cli.map import parse_detector_options
+        from capnav.perception import DETECTORS
+        from capnav.sim.furniture import FURNITURE
+
+        if detector not in DETECTORS.names():
+            raise typer.BadParameter(f"unknown detector {detector!r}; available: {', '.join(DETECTORS.names())}",
+                                     param_hint="--detector")
+        if furniture not in FURNITURE.names():
+            raise typer.BadParameter(f"unknown furniture {furniture!r}; available: {', '.join(FURNITURE.names())}",
+                                     param_hint="--furniture")
+        from capnav.sim.config import HOUSE_SIZES
+
+        if size not in HOUSE_SIZES:
+            raise typer.BadParameter(f"unknown house size {size!r}; choose from {', '.join(HOUSE_SIZES)}",
+                                     param_hint="--size")
+        opts = parse_detector_options(detector_option or [])
         sets = {}
         protos: tuple[str, ...]
         if instructions is not None:
@@ -63,7 +91,9 @@ def register(app: typer.Typer) -> None:
             protos = tuple(parse_protocols(protocols))
         cfg = EvalConfig(scenes=scenes, episodes_per_scene=episodes_per_scene, seed=seed, methods=names,
                          protocols=protos, pictures_per_scene=pictures, max_steps=max_steps,
-                         pipeline=PipelineConfig(width=width, height=height, max_frames=max_frames))
+                         pipeline=PipelineConfig(width=width, height=height, max_frames=max_frames,
+                                                 detector=detector, detector_noise=noise, furniture=furniture, size=size,
+                                                 detector_options=tuple(sorted(opts.items()))))
         on_interrupt(f"workers stopped; finished apartments are kept in {out}/scenes (run the same command "
                      "again to resume from them)")
         res = run_benchmark(cfg, out, workers=workers, ray_address=ray, episodes_dir=episodes, progress=progress,

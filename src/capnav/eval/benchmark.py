@@ -100,6 +100,7 @@ def run_benchmark(config: EvalConfig, out: str | Path, workers: int = 1, ray_add
     meta = {"version": version, "commit": commit, "seed": config.seed, "scenes": len(scene_seeds),
             "scene_seeds": scene_seeds, "episodes_per_scene": config.episodes_per_scene,
             "detector": f"{config.pipeline.detector}:{config.pipeline.detector_noise}",
+            "track": config.pipeline.track,
             "embedder": config.pipeline.embedder, "command": command or "capnav eval", "workers": workers,
             "instructions": next((str(es.generator.get("instructions")) for es in given.values()
                                   if "instructions" in es.generator), None),

@@ -83,12 +83,14 @@ class EpisodeSet(BaseModel):
         for e in self.episodes:
             if e.scene_seed not in known:
                 raise ValueError(f"episode {e.id} uses scene {e.scene_seed} not listed in scene_seeds")
+            if self.protocol != "phrasing" and e.start is None:
+                raise ValueError(f"episode {e.id}: a {self.protocol} episode needs a start pose")
             for i, g in enumerate(e.subgoals):
-                if self.protocol == "description" and len(g.target_ids) != 1:
-                    raise ValueError(f"episode {e.id} subgoal {i}: a description goal has exactly one target")
                 if self.protocol != "phrasing" and (not g.target_ids or not g.category):
                     raise ValueError(f"episode {e.id} subgoal {i}: a {self.protocol} goal needs a category and "
-                                     "at least one target")
+                                     "at least one of target_ids")
+                if self.protocol == "description" and len(g.target_ids) != 1:
+                    raise ValueError(f"episode {e.id} subgoal {i}: a description goal has exactly one target")
         return self
 
     def for_scene(self, scene_seed: int) -> list[Episode]:

@@ -16,6 +16,7 @@ import time
 from collections.abc import Iterator
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any
 
 from capnav.core.errors import CapNavError
 from capnav.core.frame import Frame
@@ -23,6 +24,7 @@ from capnav.language.embedder import TextEmbedder
 from capnav.mapping.cmap import CapNavMap
 from capnav.perception.base import Detector
 from capnav.sim import CameraConfig, ExploreConfig, SimConfig, Simulator, explore
+from capnav.sim.config import house_config
 
 MAP_FILE = "map.capnav"
 
@@ -35,14 +37,24 @@ class PipelineConfig:
     height: int = 240
     max_frames: int | None = None  # subsample the exploration stream (None: all, ~200-400 frames)
     detector: str = "sim"
-    detector_noise: str = "default"
+    detector_noise: str = "default"  # the sim detector's noise preset (other detectors ignore it)
+    detector_options: tuple[tuple[str, Any], ...] = ()  # backend settings of a real detector (model_dir, ...)
+    furniture: str = "primitives"  # or "sh3d": Sweet Home 3D meshes (``capnav assets``)
+    size: str = "default"  # house size preset (capnav.sim.config.HOUSE_SIZES): default or large
     encoder: str = "label-embedding"
     embedder: str = "minilm"
     captioner: str = "offline"
     verifier: str = "offline"
 
     def sim_config(self) -> SimConfig:
-        return SimConfig(camera=CameraConfig(width=self.width, height=self.height))
+        return house_config(self.size, SimConfig(camera=CameraConfig(width=self.width, height=self.height),
+                                                 furniture=self.furniture))
+
+    @property
+    def track(self) -> str:
+        """The perception track a result belongs to: house size, furniture and detector (with its noise)."""
+        det = f"{self.detector}:{self.detector_noise}" if self.detector == "sim" else self.detector
+        return f"{self.size} houses, {self.furniture} furniture, {det} detector"
 
     def explore_config(self, seed: int) -> ExploreConfig:
         return ExploreConfig(seed=seed, max_frames=self.max_frames)
@@ -109,7 +121,8 @@ def open_sim_scene(scene_seed: int, seed: int, config: PipelineConfig, folder: P
     t0 = time.perf_counter()
     sim = Simulator.from_seed(scene_seed, config.sim_config())
     emb = embedder or create_embedder(config.embedder)
-    det = create_detector(config.detector, noise=config.detector_noise, seed=seed)
+    det = create_detector(config.detector, noise=config.detector_noise, seed=seed) if config.detector == "sim" \
+        else create_detector(config.detector, **dict(config.detector_options))
     folder.mkdir(parents=True, exist_ok=True)
     return SimScene(scene_seed, seed, config, sim, emb, det, folder, timings={"simulator": time.perf_counter() - t0})
 

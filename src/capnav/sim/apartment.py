@@ -159,13 +159,20 @@ def _shade(rgb: RGB, f: float) -> RGB:
     return (int(min(255, rgb[0] * f)), int(min(255, rgb[1] * f)), int(min(255, rgb[2] * f)))
 
 
-def _appearance(cat: str, rng: np.random.Generator, used: dict[str, list[str]]) -> tuple[str, str, dict[str, RGB]]:
+def _appearance(cat: str, rng: np.random.Generator, used: dict[str, list[str]], near_prob: float = 0.0
+                ) -> tuple[str, str, dict[str, RGB]]:
+    """Colour name, material and part colours of a new instance. With ``near_prob`` > 0 another
+    instance of a category may take a shade of an earlier one's colour (same name, a lookalike)."""
     colors, materials = CATEGORY_STYLE[cat]
-    fresh = [c for c in colors if c not in used.get(cat, [])] or colors
-    name = fresh[int(rng.integers(len(fresh)))]
+    near = near_prob > 0.0 and bool(used.get(cat)) and rng.random() < near_prob
+    if near:
+        name = used[cat][int(rng.integers(len(used[cat])))]
+    else:
+        fresh = [c for c in colors if c not in used.get(cat, [])] or colors
+        name = fresh[int(rng.integers(len(fresh)))]
     used.setdefault(cat, []).append(name)
     material = materials[int(rng.integers(len(materials)))]
-    main = COLORS[name]
+    main = _shade(COLORS[name], float(rng.uniform(0.88, 1.12))) if near else COLORS[name]
     roles: dict[str, RGB] = dict(ROLE_COLORS)
     roles["main"] = main
     roles["accent"] = _shade(main, 1.15 if cat in ("sofa", "armchair", "ottoman") else 0.85)
@@ -183,6 +190,10 @@ def _appearance(cat: str, rng: np.random.Generator, used: dict[str, list[str]]) 
     return name, material, roles
 
 
+#: Small pieces the large preset scatters in front of furniture (partial occlusion, lookalikes).
+_CLUTTER = ("plant", "ottoman", "stool")
+
+
 def _fill(plan: FloorPlan, cfg: SimConfig, rng: np.random.Generator) -> list[tuple[Placed, str, str, dict[str, RGB]]]:
     h = cfg.layout.wall_thickness / 2
     placed: list[Placed] = []
@@ -195,15 +206,26 @@ def _fill(plan: FloorPlan, cfg: SimConfig, rng: np.random.Generator) -> list[tup
         plan_items = list(ROOM_PLANS[rtype])
         if rtype == "living room" and not has_kitchen:
             plan_items = plan_items[:4] + OPEN_KITCHEN + plan_items[4:]
+        fc = cfg.furnish
+        if fc.clutter_per_room[1] > 0:  # small pieces in front of this room's furniture
+            n_clutter = int(rng.integers(fc.clutter_per_room[0], fc.clutter_per_room[1] + 1))
+            hosts = [c for c, _, _, r in plan_items if r in ("wall", "corner") and c not in _CLUTTER]
+            for _ in range(n_clutter if hosts else 0):
+                host = hosts[int(rng.integers(len(hosts)))]
+                plan_items.append((_CLUTTER[int(rng.integers(len(_CLUTTER)))], 1, 1, f"front:{host}"))
         for cat, lo, hi, rule in plan_items:
+            if fc.count_scale != 1.0:
+                hi = max(lo, round(hi * fc.count_scale))
             count = int(rng.integers(lo, hi + 1))
+            if fc.max_per_category is not None:
+                count = min(count, fc.max_per_category - sum(p.category == cat for p in placed))
             shared: tuple[Model, tuple[str, str, dict[str, RGB]]] | None = None
             for _ in range(count):
                 if shared is not None and rule.startswith(("around:", "front:counter")):
                     model, look = shared  # a matching set (dining chairs, bar stools)
                 else:
                     model = build_model(cat, rng)
-                    look = _appearance(cat, rng, used)
+                    look = _appearance(cat, rng, used, fc.near_color_prob)
                     shared = (model, look)
                 cand = filler.place(cat, model, rule)
                 if cand is not None:
@@ -228,8 +250,9 @@ def _prune_unreachable(items: list[SceneObject], walls: RectSet, bounds: tuple[f
                 bad.append(i)
         if not bad:
             return items
-        drop = max(bad, key=lambda i: items[i].model.size[0] * items[i].model.size[1])
-        items = items[:drop] + items[drop + 1:]
+        bad.sort(key=lambda i: -items[i].model.size[0] * items[i].model.size[1])  # largest first (stable)
+        gone = set(bad[:cfg.furnish.prune_batch])
+        items = [o for i, o in enumerate(items) if i not in gone]
 
 
 def _drop_orphans(items: list[SceneObject]) -> list[SceneObject]:
@@ -264,7 +287,7 @@ def generate_apartment(seed: int, cfg: SimConfig) -> Apartment:
         lost = len(placed) - len(items)
         if lost < best_lost:
             best, best_lost = items, lost
-        if lost <= 1:
+        if lost <= cfg.furnish.accept_lost:
             break
     if best is None:
         raise InputError(f"seed {seed}: could not furnish the apartment with a category of >= 3 instances")

@@ -78,6 +78,10 @@ class DepthNoiseConfig:
     seed: int = 0
 
 
+#: The largest floor plan the generator makes (the large preset uses 8-14 rooms).
+MAX_ROOMS = 16
+
+
 @dataclass(frozen=True)
 class LayoutConfig:
     """Procedural floor plan: ``rooms`` None draws 3..7 from the seed."""
@@ -93,10 +97,36 @@ class LayoutConfig:
     extra_door_prob: float = 0.35
 
     def __post_init__(self) -> None:
-        if self.rooms is not None and not (3 <= self.rooms <= 7):
-            raise InputError(f"rooms must be between 3 and 7, got {self.rooms}")
-        if not (3 <= self.min_rooms <= self.max_rooms <= 7):
-            raise InputError(f"need 3 <= min_rooms <= max_rooms <= 7, got {self.min_rooms}, {self.max_rooms}")
+        if self.rooms is not None and not (3 <= self.rooms <= MAX_ROOMS):
+            raise InputError(f"rooms must be between 3 and {MAX_ROOMS}, got {self.rooms}")
+        if not (3 <= self.min_rooms <= self.max_rooms <= MAX_ROOMS):
+            raise InputError(f"need 3 <= min_rooms <= max_rooms <= {MAX_ROOMS}, got {self.min_rooms}, "
+                             f"{self.max_rooms}")
+
+
+@dataclass(frozen=True)
+class FurnishConfig:
+    """How densely rooms are furnished. The defaults give the benchmark's apartments; the large
+    preset adds instances of a kind (in near colours: lookalikes told apart only by shade, place or
+    size) and clutter (small pieces in front of furniture)."""
+
+    count_scale: float = 1.0  # multiplies each room plan's maximum count of a category
+    near_color_prob: float = 0.0  # chance that another instance of a category takes a shade of an earlier colour
+    clutter_per_room: tuple[int, int] = (0, 0)  # small pieces (plants, stools, ottomans) in front of furniture
+    # Generation speed in big houses: a furnishing that loses at most ``accept_lost`` objects to the
+    # reachability check is kept at once, and that check drops ``prune_batch`` objects per pass.
+    max_per_category: int | None = None  # at most this many instances of one category in the house
+    accept_lost: int = 1
+    prune_batch: int = 1
+
+    def __post_init__(self) -> None:
+        if not (1.0 <= self.count_scale <= 3.0):
+            raise InputError(f"count_scale must be in [1, 3], got {self.count_scale}")
+        if not (0.0 <= self.near_color_prob <= 1.0):
+            raise InputError(f"near_color_prob must be in [0, 1], got {self.near_color_prob}")
+        lo, hi = self.clutter_per_room
+        if not (0 <= lo <= hi <= 6):
+            raise InputError(f"clutter_per_room must satisfy 0 <= lo <= hi <= 6, got {self.clutter_per_room}")
 
 
 @dataclass(frozen=True)
@@ -111,3 +141,24 @@ class SimConfig:
     assets_dir: str | None = None  # where `capnav assets` extracted the meshes (default cache)
     textures: bool = True  # procedural material / floor textures
     nav_resolution: float = 0.05
+    furnish: FurnishConfig = field(default_factory=FurnishConfig)
+
+
+#: House sizes. ``default``: the benchmark's apartments (3-7 rooms, 40-110 m², 15-47 objects).
+#: ``large``: near Matterport3D houses' scale (8-14 rooms with hallways, 120-250 m², 60-150
+#: objects, up to 6 instances of a category in near colours, clutter in front of furniture).
+HOUSE_SIZES: tuple[str, ...] = ("default", "large")
+
+
+def house_config(size: str, base: SimConfig | None = None) -> SimConfig:
+    """``base`` (default: ``SimConfig()``) with the layout and furnishing of a house-size preset."""
+    from dataclasses import replace
+
+    base = base or SimConfig()
+    if size == "default":
+        return base
+    if size == "large":
+        return replace(base, layout=replace(base.layout, min_rooms=8, max_rooms=14, room_area=(15.0, 18.0)),
+                       furnish=FurnishConfig(count_scale=2.0, near_color_prob=0.6, clutter_per_room=(1, 3),
+                                             max_per_category=6, accept_lost=8, prune_batch=4))
+    raise InputError(f"unknown house size {size!r}; choose from {', '.join(HOUSE_SIZES)}")

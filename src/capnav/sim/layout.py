@@ -96,24 +96,40 @@ def _split(rng: np.random.Generator, rects: list[Rect], n: int, min_side: float)
     return rects
 
 
+#: Room types of an n-room plan: the first 7 as the benchmark's apartments, then houses grow by
+#: this cycle (more bedrooms, hallways joining them, bathrooms, studies, a second living area).
+_BASE_TYPES = ["living room", "kitchen", "bedroom", "bathroom", "office", "bedroom", "hallway"]
+_MORE_TYPES = ["bedroom", "hallway", "bathroom", "office", "bedroom", "living room", "hallway", "bathroom", "kitchen"]
+
+
+def room_types(n: int) -> list[str]:
+    """The multiset of room types of an n-room floor plan."""
+    small = {3: ["living room", "bedroom", "bathroom"], 4: ["living room", "kitchen", "bedroom", "bathroom"],
+             5: ["living room", "kitchen", "bedroom", "bathroom", "office"],
+             6: ["living room", "kitchen", "bedroom", "bathroom", "office", "bedroom"]}
+    if n in small:
+        return list(small[n])
+    return _BASE_TYPES + [_MORE_TYPES[i % len(_MORE_TYPES)] for i in range(n - 7)]
+
+
 def _assign_types(rects: list[Rect], rng: np.random.Generator) -> list[str]:
+    """Living rooms take the largest rooms, hallways the most elongated, bathrooms the smallest."""
     n = len(rects)
-    wanted = {3: ["living room", "bedroom", "bathroom"],
-              4: ["living room", "kitchen", "bedroom", "bathroom"],
-              5: ["living room", "kitchen", "bedroom", "bathroom", "office"],
-              6: ["living room", "kitchen", "bedroom", "bathroom", "office", "bedroom"],
-              7: ["living room", "kitchen", "bedroom", "bathroom", "office", "bedroom", "hallway"]}[n]
+    wanted = room_types(n)
     types = [""] * n
     by_area = sorted(range(n), key=lambda i: -rects[i].area)
-    types[by_area[0]] = "living room"
-    rest = by_area[1:]
-    if "hallway" in wanted:  # the most elongated remaining room
+    rest = list(by_area)
+    for _ in range(wanted.count("living room")):
+        types[rest[0]] = "living room"
+        rest.pop(0)
+    for _ in range(wanted.count("hallway")):
         hall = max(rest, key=lambda i: max(rects[i].w, rects[i].h) / min(rects[i].w, rects[i].h))
         types[hall] = "hallway"
         rest.remove(hall)
-    bath = rest[-1]  # the smallest
-    types[bath] = "bathroom"
-    rest.remove(bath)
+    for _ in range(wanted.count("bathroom")):
+        bath = rest[-1]  # the smallest
+        types[bath] = "bathroom"
+        rest.remove(bath)
     others = [t for t in wanted if t not in ("living room", "hallway", "bathroom")]
     perm = rng.permutation(len(rest))
     for t, k in zip(others, perm, strict=True):

@@ -103,7 +103,8 @@ class RoomFiller:
             return False
         if any(rects_overlap(c, z) for z in self.zones):
             return False
-        return not any(rects_overlap(c, p.corners, margin) for p in self.placed)
+        # Pieces of other rooms lie beyond a wall (thicker than ``margin``): only this room's can overlap.
+        return not any(p.room == self.room and rects_overlap(c, p.corners, margin) for p in self.placed)
 
     def _wall(self, cat: str, model: Model, corner: bool) -> Placed | None:
         w, d = model.size[0], model.size[1]
