@@ -92,7 +92,8 @@ def register(app: typer.Typer) -> None:
         cfg = EvalConfig(scenes=scenes, episodes_per_scene=episodes_per_scene, seed=seed, methods=names,
                          protocols=protos, pictures_per_scene=pictures, max_steps=max_steps,
                          pipeline=PipelineConfig(width=width, height=height, max_frames=max_frames,
-                                                 detector=detector, detector_noise=noise, furniture=furniture, size=size,
+                                                 detector=detector, detector_noise=noise, furniture=furniture,
+                                                 size=size,
                                                  detector_options=tuple(sorted(opts.items()))))
         on_interrupt(f"workers stopped; finished apartments are kept in {out}/scenes (run the same command "
                      "again to resume from them)")

@@ -109,8 +109,8 @@ def render(summaries: Sequence[Summary], config: Mapping[str, Any],
                f"{config.get('episodes_per_scene')} episodes per apartment and protocol, "
                f"detector `{config.get('detector', '?')}`, embedder `{config.get('embedder', '?')}`.")
     out.append("")
-    out.append(f"Track: **{config.get('track', 'default houses, primitives furniture, sim:default detector')}**; every table "
-               "below belongs to this track.")
+    track = config.get("track", "default houses, primitives furniture, sim:default detector")
+    out.append(f"Track: **{track}**; every table below belongs to this track.")
     out.append("")
     out.append(f"Command: `{config.get('command', 'capnav eval')}`")
     out.append("")
