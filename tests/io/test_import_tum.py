@@ -160,14 +160,21 @@ def test_errors_name_the_file_and_line(tmp_path: Path, frames: list[Frame]) -> N
         TumReader(tmp_path / "nope", "fr1")
 
 
-def test_corrupt_image_leaves_nothing(tmp_path: Path, frames: list[Frame]) -> None:
+def test_a_corrupt_image_costs_its_frame_and_only_unreadable_images_leave_nothing(
+        tmp_path: Path, frames: list[Frame]) -> None:
     seq = tmp_path / "seq"
     write_tum(seq, frames[:3])
-    sorted((seq / "rgb").iterdir())[2].write_bytes(b"\x89PNG not really")
-    rec = TumReader(seq, seq / "cam.json")
-    with pytest.raises(InputError, match=r"corrupt colour image .*rgb/"):
-        import_recording(rec, tmp_path / "ds", up="-y", progress=False)
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["seq"]
+    rgbs = sorted((seq / "rgb").iterdir())
+    rgbs[2].write_bytes(b"\x89PNG not really")
+    rep = import_recording(TumReader(seq, seq / "cam.json"), tmp_path / "ds", up="-y", progress=False)
+    assert len(DatasetReader(tmp_path / "ds")) == 2
+    text = "\n".join(rep.lines())
+    assert "skipped 1: unreadable image" in text and rgbs[2].name in text
+    for p in rgbs[:2]:
+        p.write_bytes(b"")
+    with pytest.raises(InputError, match="every selected frame was skipped"):
+        import_recording(TumReader(seq, seq / "cam.json"), tmp_path / "ds2", up="-y", progress=False)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ds", "seq"]
 
 
 def test_cli(tmp_path: Path, frames: list[Frame]) -> None:

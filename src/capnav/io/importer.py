@@ -116,6 +116,7 @@ def import_recording(rec: Recording, out: str | Path, up: str = "auto", stride: 
     align = floor_alignment(views, rec.K, up, floor, poses=np.stack([f.T_wc for f in frames]))
 
     skipped = SkipLog(list(rec.skipped.skips))
+    n_before = len(rec.skipped.skips)  # the reader counts frames it cannot load while they are written
     meta: dict[str, Any] = {"source": rec.kind, "recording": str(rec.path), **rec.meta,
                             "alignment": align.to_meta()}
     with atomic_dir(out, overwrite=True) as tmp:  # the target was checked above
@@ -133,6 +134,7 @@ def import_recording(rec: Recording, out: str | Path, up: str = "auto", stride: 
                 continue
             depth = np.where(valid, depth, 0.0).astype(np.float32)
             w.write(Frame(index=len(w), rgb=rgb, depth=depth, K=rec.K, T_wc=align.A @ f.T_wc, timestamp=f.timestamp))
+        skipped.skips.extend(rec.skipped.skips[n_before:])
         if len(w) == 0:
             raise InputError(f"{rec.path}: every selected frame was skipped ({skipped.counts()})")
         w.meta["import"] = {"associated": len(rec.frames), "selected": len(frames), "written": len(w),

@@ -173,10 +173,21 @@ class TumReader:
                                      "poses": len(track)}
 
     def load_depths(self, frames: list[PlannedFrame]) -> Iterator[tuple[PlannedFrame, NDArray[np.float32]]]:
+        """Depth images for the floor fit; unreadable ones are left out here (``load`` counts them)."""
         for f in frames:
-            yield f, read_depth(f.depth, self.depth_scale)
+            try:
+                yield f, read_depth(f.depth, self.depth_scale)
+            except InputError:
+                continue
 
     def load(self, frames: list[PlannedFrame]) -> Iterator[tuple[PlannedFrame, NDArray[np.uint8],
                                                                 NDArray[np.float32]]]:
+        """Colour and depth per frame; a frame whose image is missing or corrupt is skipped and
+        counted in ``skipped`` with the file and the decoder's complaint, never the whole import."""
         for f in frames:
-            yield f, read_rgb(f.rgb), read_depth(f.depth, self.depth_scale)
+            try:
+                rgb, depth = read_rgb(f.rgb), read_depth(f.depth, self.depth_scale)
+            except InputError as e:
+                self.skipped.add(f.name, f.timestamp, "unreadable image", str(e))
+                continue
+            yield f, rgb, depth
