@@ -36,6 +36,8 @@ def test_caption_then_query(map_file: Path, tmp_path: Path):
     assert r.exit_code != 0 and "X,Y" in str(r.exception)
     r = runner.invoke(app, ["query", str(out), "the piano"])
     assert r.exit_code == 1 and "not found" in r.stdout  # answered "not found": exit code 1
+    r = runner.invoke(app, ["query", str(out), "the piano", "--json"])
+    assert r.exit_code == 0 and json.loads(r.stdout)["found"] is False  # JSON carries the answer: exit 0
 
 
 def test_mismatched_embedder_is_refused(map_file: Path, tmp_path: Path):

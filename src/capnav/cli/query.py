@@ -33,7 +33,8 @@ def register(app: typer.Typer) -> None:
         embedder: str = typer.Option("auto", help="auto (the map's default model) or a backend name"),
         embedder_path: Path | None = typer.Option(None, help="local model folder for non-default embedders"),
     ) -> None:
-        """Retrieve the object an instruction describes (paper 3.4); exit code 1 when nothing matches."""
+        """Retrieve the object an instruction describes (paper 3.4); exit code 1 when nothing matches
+        (0 with --json, whose payload says "found": false)."""
         from capnav.cli.options import check_model_folder, check_verifier
         from capnav.io.mapfile import load_map
         from capnav.language import create_embedder
@@ -64,7 +65,10 @@ def register(app: typer.Typer) -> None:
             typer.echo(json.dumps(res.to_dict(), indent=2))
         else:
             _print(res)
-        if res.chosen is None:  # answered "not found": exit code 1, as `capnav navigate` when not reached
+        # Answered "not found": exit code 1, as `capnav navigate` when not reached. With --json the
+        # answer is in the payload ("found": false) and a printed answer exits 0, so that scripts
+        # that read JSON (and treat a non-zero exit as a failure to answer) see a refusal as one.
+        if res.chosen is None and not as_json:
             raise typer.Exit(1)
 
 
