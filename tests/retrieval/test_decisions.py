@@ -115,6 +115,22 @@ def test_negation_excludes_what_it_names(retriever):
     assert not res.found
 
 
+def test_each_negated_alternative_is_excluded_from_the_words_alone(retriever):
+    # Parsed end to end: "green or blue" is two exclusions, not one phrase both must fit.
+    res = retriever.query("the armchair that isn't green or blue")
+    assert res.found and res.chosen.id == 11
+    res = retriever.query("an armchair that is not pink or green")  # both armchairs excluded
+    assert res.chosen is None or res.chosen.id not in (11, 14)
+
+
+def test_a_landmark_clause_colour_belongs_to_the_landmark(retriever):
+    # "red" describes the lamp; the armchair beside the red lamp is the green one.
+    res = retriever.query("the armchair the red lamp is standing next to")
+    assert res.found and res.chosen.id == 14
+    res = retriever.query("the armchair that the yellow lamp stands beside")
+    assert res.found and res.chosen.id == 11
+
+
 def test_ordinal_takes_the_nth_in_the_predicate_order(retriever):
     assert retriever.query("the closest stool", robot_xy=(0.5, 2.5)).chosen.id == 3
     res = ask(retriever, "the second closest stool", robot=(0.5, 2.5), ordinal=2)

@@ -147,6 +147,32 @@ def test_negations(text, cat, neg):
     assert negated.colors or negated.room
 
 
+@pytest.mark.parametrize(("text", "cat", "neg"), [
+    ("the vase that is not red or blue", None, ["red", "blue"]),
+    ("not the white or the grey stool", "stool", ["white", "grey"]),
+    ("a lamp which isn't in the kitchen or in the office", "lamp", ["in the kitchen", "in the office"]),
+])
+def test_negated_alternatives_are_excluded_one_by_one(text, cat, neg):
+    q = parse_instruction(text)
+    assert q.category == cat and sorted(q.negations) == sorted(neg) and not q.colors
+
+
+@pytest.mark.parametrize(("text", "cat", "anchor", "phrase"), [
+    ("the table the green lamp is standing beside", "table", "lamp", "green lamp"),
+    ("the desk that the white stool is tucked under", "desk", "stool", "white stool"),
+    ("the sofa the small ottoman sits in front of", "sofa", "ottoman", "small ottoman"),
+])
+def test_a_landmark_clause_keeps_its_words_off_the_target(text, cat, anchor, phrase):
+    q = parse_instruction(text)
+    assert (q.category, q.anchor_category, q.anchor_phrase, q.relation) == (cat, anchor, phrase, "next to")
+    assert q.colors == [] and q.size_word is None
+
+
+def test_a_verb_after_the_target_alone_is_no_landmark():
+    q = parse_instruction("the chair is in the kitchen")
+    assert q.category == "chair" and q.anchor_category is None and q.room == "kitchen"
+
+
 @pytest.mark.parametrize(("text", "cat"), [
     ("the refrigirator", "refrigerator"), ("the wardobe", "wardrobe"), ("the bookshelff", "bookshelf"),
     ("the washin machine", "washing machine"),

@@ -305,6 +305,50 @@ def _landmark_proximity(q: ParsedQuery, head: str) -> str:
     return (head[: m.start()] + " " + m.group("mid") + " " + " ".join(anchor_words[span[1]:])).strip()
 
 
+#: Verbs of a landmark clause ("the desk the pink chair is pulled up to", "the table that the lamp
+#: stands beside"): the clause's subject is the landmark, not a description of the target.
+_CLAUSE_VERB = re.compile(r"\b(?:is|are|was|were|sits|sit|stands|stand|rests|lies|has\s+been)\b")
+
+
+def _clause_landmark(q: ParsedQuery, head: str) -> str:
+    """"the desk the pink chair is pulled up to", "the table that the green lamp stands beside":
+    a second noun phrase after the target, followed by a verb, is a landmark next to the target;
+    its words (colours, sizes) are the landmark's. Returns ``head`` without the clause."""
+    words = head.split()
+    cat, span, _ = _find_category(words)
+    if cat is None or span is None:
+        return head
+    k = span[1]
+    if k < len(words) and words[k] in ("that", "which", "where"):
+        k += 1
+    if k >= len(words) or words[k] not in ("the", "a", "an", "my", "our"):
+        return head
+    rest = " ".join(words[k + 1:])
+    m = _CLAUSE_VERB.search(rest)
+    if m is None or m.start() == 0:
+        return head
+    anchor_words = rest[: m.start()].split()
+    acat, aspan, _ = _find_category(anchor_words)
+    if acat is None or aspan is None or aspan[1] != len(anchor_words):
+        return head
+    q.relation = "next to"
+    q.anchor_category = acat
+    q.anchor_phrase = " ".join(anchor_words)
+    return " ".join(words[: span[1]])
+
+
+def _split_alternatives(words: list[str]) -> list[list[str]]:
+    """"purple or orange", "red nor blue", "the white or the grey one": one negated phrase per
+    alternative, so each is excluded on its own (a phrase is excluded only when all of it fits)."""
+    parts: list[list[str]] = [[]]
+    for w in words:
+        if w in ("or", "nor"):
+            parts.append([])
+        else:
+            parts[-1].append(w)
+    return [p for p in parts if p]
+
+
 def _negations(q: ParsedQuery, head: str) -> str:
     """Fill ``q.negations`` with what the target must not be, as short phrases a parse of their own
     reads ("white", "in the bedroom"); returns ``head`` without them. The negated phrase's category
@@ -318,11 +362,12 @@ def _negations(q: ParsedQuery, head: str) -> str:
             words = words[:span[0]] + words[span[1]:]
         else:
             out = out[: m.start()] + " " + out[m.end():]
-        while words and words[0] in ("the", "a", "an", "one", "other", "that", "which", "is", "are", "be"):
-            words = words[1:]
-        words = [w for w in words if w not in ("one", "ones", "other")]
-        if words:
-            q.negations.append(" ".join(words))
+        for part in _split_alternatives(words)[::-1]:
+            while part and part[0] in ("the", "a", "an", "one", "other", "that", "which", "is", "are", "be"):
+                part = part[1:]
+            part = [w for w in part if w not in ("one", "ones", "other")]
+            if part:
+                q.negations.append(" ".join(part))
     out = re.sub(r"\bthe\s+other\s+(?:one|of\s+the\s+two)\b", " ", out)
     return " ".join(out.split())
 
@@ -363,6 +408,9 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> Parsed
                 break
         head = re.sub(r"\b(?:to|from)\s+(?:me|you|us|here|the robot)\b|\baway\b", " ", head) \
             if q.proximity else head
+    # A landmark clause: "the desk the pink chair is pulled up to".
+    if q.anchor_category is None:
+        head = _clause_landmark(q, head)
     # Relation: "<target> next to the <anchor>".
     if q.anchor_category is None:
         for rel in _RELATIONS:
