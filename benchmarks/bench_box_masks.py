@@ -15,7 +15,7 @@ Truth is read here only (evaluation).
    nearest strong depth mode grown along smooth depth, before issue 11) and ``"surfaces"``.
 2. Per map: the whole pass mapped with those masks (labels from the truth, every
    ``--map-stride``-th frame), objects matched to instances by ``capnav.eval.map_quality``, and
-   the size error of each matched instance's object (``quality.size_error``: the larger of the
+   the size error of each matched instance's object (``map_quality.size_error``: the larger of the
    caption width and height errors), median per category.
 """
 

@@ -7,14 +7,14 @@
 Each apartment (``sh3d_data.dataset``: ``capnav sim --furniture sh3d --seed S``, rendered once and
 cached) is mapped once per detector from the same frames (the ``sim`` detector at its default
 noise, seed 0; the real ones with their defaults and masks from depth), and each map is scored
-against the apartment's manifest by ``capnav.mapping.quality.evaluate_map``. Per CapNav category
+against the apartment's manifest by ``capnav.eval.map_quality.evaluate_map``. Per CapNav category
 that a COCO class maps to (``capnav.perception.coco.TO_CAPNAV``), pooled over the apartments:
 
 - recall: instances seen in >= 5 frames (>= 100 px each) with at least one map object on them;
 - precision: map objects labelled with the category that lie on an instance (of any category);
 - duplicates: map objects beyond the first on the category's instances, over the objects on them;
 - category accuracy: objects on the category's instances that carry its label;
-- size error: median over the category's mapped instances of ``quality.size_error`` (the larger
+- size error: median over the category's mapped instances of ``map_quality.size_error`` (the larger
   of the caption width and height errors of the instance's best object).
 
 Truth is read here only (evaluation); the detectors see pixels, depth and poses.
@@ -60,7 +60,7 @@ def make_detector(name: str, weights: Path) -> Any:
 def score(cmap: Any, manifest: Any, seen: dict[int, int], counts: dict[str, dict[str, float]],
           sizes: dict[str, list[float]], cats: set[str]) -> None:
     """Add one map's per-category counts (see the module docstring) to ``counts`` / ``sizes``."""
-    from capnav.mapping.quality import QualityConfig, evaluate_map
+    from capnav.eval.map_quality import QualityConfig, evaluate_map
 
     q = evaluate_map(cmap, manifest, seen)
     min_frames = QualityConfig().min_frames
@@ -102,8 +102,7 @@ def main() -> None:
     args = ap.parse_args()
     dataset = importlib.import_module("sh3d_data").dataset  # beside this script
 
-    from capnav.mapping.quality import visible_frames
-
+    from capnav.eval.map_quality import visible_frames
     from capnav.io.dataset import DatasetReader
     from capnav.mapping import build_map
     from capnav.perception.coco import TO_CAPNAV
