@@ -189,3 +189,27 @@ def test_an_alternative_does_not_serve_a_bare_name_whose_category_is_absent(retr
     assert res.found and res.chosen.id == 17
     # An unknown noun whose alternatives the map has is not served by them either.
     assert not ask(retriever, "the harpsichord", category=None, category_alternatives={"stool": 0.4}).found
+
+
+def test_a_hallway_is_the_region_where_no_rooms_objects_stand(emb):
+    # A bedroom (bed, nightstand, lamp) left of a wall with a door; right of it only a lamp and a
+    # plant: no room's characteristic objects, so that region is the hallway.
+    objs = [make_obj(1, "bed", (1.5, 1.5), (1.6, 2.0, 0.6), (40, 60, 160)),
+            make_obj(2, "nightstand", (3.0, 0.5), (0.5, 0.5, 0.6), (120, 80, 40)),
+            make_obj(3, "lamp", (3.6, 3.4), (0.4, 0.4, 1.5), (240, 240, 235)),
+            make_obj(4, "lamp", (7.5, 3.4), (0.4, 0.4, 1.5), (240, 240, 235)),
+            make_obj(5, "plant", (8.5, 0.5), (0.5, 0.5, 1.0), (40, 140, 50))]
+    grid = grid_with_wall(-0.5, -0.5, 9.5, 4.0, wall_x=5.0, door=(1.0, 2.0))
+    scene = SceneContext(objs, grid)
+    assert scene.rooms[2] == "bedroom" and scene.rooms[3] is None  # lamps 3 and 4
+    cap = create_captioner("offline")
+    for o in objs:
+        o.caption = cap.caption(o, scene).text
+    for o, v in zip(objs, emb.embed([o.caption for o in objs]), strict=True):
+        o.embedding, o.embedding_model = v, emb.model_id
+    r = Retriever(make_map(objs, grid), emb)
+    for text in ("the lamp in the hallway", "the hall lamp", "take me to the lamp in the corridor"):
+        res = r.query(text)
+        assert res.found and res.chosen.id == 4, text
+        assert "hallway" in res.reason
+    assert r.query("the lamp in the bedroom").chosen.id == 3

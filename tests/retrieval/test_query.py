@@ -215,3 +215,13 @@ def test_requests_by_purpose(text, cats, emb):
     assert q.purpose and q.category in cats, q.to_dict()
     assert all(0 < w < 1 for w in q.category_alternatives.values())
     assert parse_instruction(text).category is None  # without an embedder: the purpose, no category
+
+
+@pytest.mark.parametrize(("text", "cat"), [
+    ("the plant in the hallway", "plant"), ("the hall table", "table"), ("the lamp out in the corridor", "lamp"),
+    ("the stool in the entrance hall", "stool"),
+])
+def test_hallway_words_name_a_room_not_an_unknown_word(text, cat):
+    q = parse_instruction(text)
+    assert q.room == "hallway" and q.category == cat
+    assert not {"hall", "hallway", "corridor"} & set(q.unknown_words)

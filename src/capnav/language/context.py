@@ -30,12 +30,17 @@ ROOM_CUES: dict[str, dict[str, float]] = {
     "living room": {"sofa": 1.0, "tv": 0.8, "coffee table": 0.8, "armchair": 0.5},
     "office": {"desk": 1.0, "bookshelf": 0.4},
 }
+#: The room type without characteristic objects: requested by name, recognised as no typed room.
+HALLWAY = "hallway"
 ROOM_SYNONYMS: dict[str, str] = {
     "kitchen": "kitchen", "bedroom": "bedroom", "bed room": "bedroom", "master bedroom": "bedroom",
     "bathroom": "bathroom", "bath room": "bathroom", "restroom": "bathroom", "washroom": "bathroom",
     "living room": "living room", "lounge": "living room", "sitting room": "living room",
     "living area": "living room", "family room": "living room",
     "office": "office", "study": "office", "home office": "office", "workroom": "office",
+    # No object marks a hallway: it is a region where no room's cues stand (see ``SceneContext._room``).
+    "hallway": HALLWAY, "hall": HALLWAY, "corridor": HALLWAY, "entrance hall": HALLWAY, "entryway": HALLWAY,
+    "hall way": HALLWAY, "passage": HALLWAY, "passageway": HALLWAY, "foyer": HALLWAY, "landing": HALLWAY,
 }
 
 
@@ -250,4 +255,5 @@ def canonical_room(text: str) -> str | None:
     return ROOM_SYNONYMS.get(text.strip().lower())
 
 
-__all__ = ["NAMES", "ROOM_CUES", "ContextConfig", "SceneContext", "canonical_label", "canonical_room", "label_of"]
+__all__ = ["HALLWAY", "NAMES", "ROOM_CUES", "ContextConfig", "SceneContext", "canonical_label", "canonical_room",
+           "label_of"]

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 from capnav.core.categories import NAMES
 from capnav.core.errors import InputError
 from capnav.core.grid import GridSpec
-from capnav.language.context import ROOM_CUES, SceneContext, canonical_label
+from capnav.language.context import HALLWAY, ROOM_CUES, SceneContext, canonical_label
 from capnav.language.embedder import TextEmbedder
 from capnav.language.prompts import caption_name
 from capnav.mapping.cmap import CapNavMap
@@ -237,6 +237,16 @@ class Retriever:
                 where = sorted({str(r) for r in rooms})
                 refusal = (f"no {q.category or q.target_phrase} stands in the {q.room}; "
                            f"{'they are' if len(pool) > 1 else 'it is'} in the {', the '.join(where)}")
+        elif cfg.use_predicates and q.room == HALLWAY and len(pool):
+            # A hallway has no characteristic objects: objects of a region without any room's cues
+            # first, then the weakest cues of any room. No refusal: an untyped region is weak evidence.
+            untyped = np.array([self.scene.rooms[i] is None for i in pool], dtype=np.float64)
+            weakest = -self.scene.room_score[pool].max(axis=1)
+            group_keys.insert(0, -untyped)
+            order_keys.append(-weakest)
+            values["no room cue"] = weakest
+            predicate, mode = "room", "predicate"
+            notes.append(f"{int(untyped.sum())} of them stand where no room's objects are (a hallway)")
         elif q.room is not None and q.room not in _ROOMS:
             notes.append(f"rooms of type '{q.room}' are not inferred from the map; the room was not used")
         if cfg.use_predicates and (q.relation is not None or q.proximity_to_anchor) and q.anchor_category is not None:
