@@ -35,6 +35,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 
+from bench_common import table  # noqa: E402
 from capnav.core.categories import BY_ID  # noqa: E402
 from capnav.core.frame import Frame  # noqa: E402
 from capnav.perception.base import Detection, Detector  # noqa: E402
@@ -42,15 +43,6 @@ from capnav.perception.box_masks import MASK_METHODS, depth_box_mask, floor_pixe
 
 CATEGORIES = ("chair", "table", "lamp")
 MIN_AREA = 0.002
-
-
-def _table(title: str, header: list[str], rows: list[list[str]]) -> None:
-    widths = [max(len(str(r[i])) for r in [header, *rows]) for i in range(len(header))]
-    print(f"\n## {title}")
-    print("  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True)))
-    print("  ".join("-" * w for w in widths))
-    for r in rows:
-        print("  ".join(str(c).ljust(w) for c, w in zip(r, widths, strict=True)))
 
 
 def truth_boxes(frame: Frame, pad: float) -> list[tuple[int, str, tuple[float, float, float, float],
@@ -179,7 +171,7 @@ def main() -> None:
                      f"{np.mean(d['iou:mode']):.2f} / {np.mean(d['iou:surfaces']):.2f}",
                      f"{np.mean(d['spill:mode']):.1%} / {np.mean(d['spill:surfaces']):.1%}"])
     n_masks = len(view["all"]["iou:mode"])
-    _table(f"mask vs true instance, true boxes +{args.pad:.0%} (seeds {' '.join(map(str, args.seeds))}, "
+    table(f"mask vs true instance, true boxes +{args.pad:.0%} (seeds {' '.join(map(str, args.seeds))}, "
            f"{args.width}x{args.height}, every {args.view_stride}th frame); mode / surfaces",
            ["category", "views", "median IoU", "mean IoU", "mask pixels off the instance"], rows)
     print(f"CPU per mask: mode {1000 * secs['mode'] / max(n_masks, 1):.1f} ms, "
@@ -194,7 +186,7 @@ def main() -> None:
             rows.append([k, f"{len(a)} / {len(b)}",
                          f"{100 * np.median(a):.0f} / {100 * np.median(b):.0f} cm" if both else "-",
                          f"{np.mean(np.asarray(a) > 0.2):.0%} / {np.mean(np.asarray(b) > 0.2):.0%}" if both else "-"])
-        _table(f"map object size error (caption width/height, worst of the two), every {args.map_stride}th frame; "
+        table(f"map object size error (caption width/height, worst of the two), every {args.map_stride}th frame; "
                "mode / surfaces", ["category", "instances mapped", "median size error", "error > 20 cm"], rows)
 
 

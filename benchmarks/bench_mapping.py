@@ -32,15 +32,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 
-
-def _table(title: str, header: list[str], rows: list[list[str]]) -> None:
-    widths = [max(len(str(r[i])) for r in [header, *rows]) for i in range(len(header))]
-    print(f"\n## {title}")
-    print("  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True)))
-    print("  ".join("-" * w for w in widths))
-    for r in rows:
-        print("  ".join(str(c).ljust(w) for c, w in zip(r, widths, strict=True)))
-
+from bench_common import table  # noqa: E402
 
 DEPTH_NOISE = False  # set by --depth-noise
 
@@ -186,12 +178,12 @@ def fusion_vs_open3d(frames: list, repeat: int = 3) -> list[list[str]]:
     origin = VoxelConfig().grid_origin
     ours: dict[int, tuple[float, int]] = {}
     for dim in (64, 1):
-        table = np.ascontiguousarray(phi[:, :dim])
-        VoxelMap(0.05, origin, feature_dim=dim).integrate(p[:1000], alpha[:1000], c[:1000], fidx[:1000], table)
+        feats = np.ascontiguousarray(phi[:, :dim])
+        VoxelMap(0.05, origin, feature_dim=dim).integrate(p[:1000], alpha[:1000], c[:1000], fidx[:1000], feats)
 
-        def fuse(dim: int = dim, table: NDArray[np.float32] = table) -> VoxelMap:
+        def fuse(dim: int = dim, feats: NDArray[np.float32] = feats) -> VoxelMap:
             vm = VoxelMap(0.05, origin, feature_dim=dim)
-            vm.integrate(p, alpha, c, fidx, table)
+            vm.integrate(p, alpha, c, fidx, feats)
             return vm
 
         dt, vm = _best_cpu(fuse, repeat)
@@ -312,7 +304,7 @@ def main() -> None:
     global DEPTH_NOISE
     DEPTH_NOISE = args.depth_noise
     if args.quality_only:
-        _table(f"mapping quality, noise {args.noise!r}, detector seed 0, depth noise {args.depth_noise}",
+        table(f"mapping quality, noise {args.noise!r}, detector seed 0, depth noise {args.depth_noise}",
                ["metric", *[f"seed {s}" for s in args.seeds], "target"], quality(args.seeds, args.noise))
         return
     sim, frames = render(args.seeds[0])
@@ -320,17 +312,17 @@ def main() -> None:
     print(f"apartment seed {args.seeds[0]}: {len(frames)} frames at {w}x{h}, detector noise {args.noise!r}, "
           "detector seed 0, one thread")
     rows, _ = throughput(frames, args.noise)
-    _table("mapping throughput (rendering excluded)", ["stage", "ms / frame", "rate"], rows)
-    _table("simulator detector per frame (instances with >= 100 / >= 2000 visible px)",
+    table("mapping throughput (rendering excluded)", ["stage", "ms / frame", "rate"], rows)
+    table("simulator detector per frame (instances with >= 100 / >= 2000 visible px)",
            ["noise", "recall >=100px", "recall >=2000px", "label swapped", "false pos./frame", "mean score"],
            detector_stats(frames))
-    _table("voxel fusion on the same points (5 cm voxels; min CPU time of 3 runs)",
+    table("voxel fusion on the same points (5 cm voxels; min CPU time of 3 runs)",
            ["method", "points", "voxels", "points/s", "ratio"],
            fusion_vs_open3d(frames))
-    _table(f"memory for a whole apartment (seed {args.seeds[0]})", ["what", "size"], memory(args.seeds[0], args.noise))
+    table(f"memory for a whole apartment (seed {args.seeds[0]})", ["what", "size"], memory(args.seeds[0], args.noise))
     sim.close()  # type: ignore[attr-defined]
     if not args.no_quality:
-        _table(f"mapping quality, noise {args.noise!r}, detector seed 0, depth noise {args.depth_noise}",
+        table(f"mapping quality, noise {args.noise!r}, detector seed 0, depth noise {args.depth_noise}",
                ["metric", *[f"seed {s}" for s in args.seeds], "target"], quality(args.seeds, args.noise))
 
 

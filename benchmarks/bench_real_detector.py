@@ -27,17 +27,7 @@ from collections.abc import Callable  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
-REPO = Path(__file__).resolve().parents[1]
-FOLDERS = {"yolo-fastest": "yolo-fastest-1.1-xl", "centernet": "centernet-mobilenetv3-coco"}
-
-
-def _table(title: str, header: list[str], rows: list[list[str]]) -> None:
-    widths = [max(len(str(r[i])) for r in [header, *rows]) for i in range(len(header))]
-    print(f"\n## {title}")
-    print("  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True)))
-    print("  ".join("-" * w for w in widths))
-    for r in rows:
-        print("  ".join(str(c).ljust(w) for c, w in zip(r, widths, strict=True)))
+from bench_common import REPO, WEIGHT_FOLDERS, table  # noqa: E402
 
 
 class _Clock:
@@ -69,7 +59,7 @@ def run(name: str, frames: list[Any], weights: Path) -> tuple[dict[str, float], 
     if name == "sim":
         det = create_detector("sim", noise="default", seed=0)
     else:
-        det = create_detector(name, model_dir=str(weights / FOLDERS[name]), threads=1)
+        det = create_detector(name, model_dir=str(weights / WEIGHT_FOLDERS[name]), threads=1)
     enc = create_encoder("label-embedding", embedder=create_embedder("minilm"))
     Mapper(MapperConfig(), det, enc).integrate(frames[0])  # warm: numba, embeddings of the labels, the model
     m = Mapper(MapperConfig(), det, enc)
@@ -108,7 +98,7 @@ def main() -> None:
     ap.add_argument("--dataset", type=Path, default=None, help="an existing 640x480 recording instead")
     ap.add_argument("--weights", type=Path, default=Path(os.environ.get("CAPNAV_SHARED", REPO.parent / "shared"))
                     / "weights")
-    ap.add_argument("--detectors", nargs="+", default=list(FOLDERS), choices=list(FOLDERS))
+    ap.add_argument("--detectors", nargs="+", default=list(WEIGHT_FOLDERS), choices=list(WEIGHT_FOLDERS))
     args = ap.parse_args()
     logging.getLogger("capnav").setLevel(logging.ERROR)  # pose jumps of a subsampled pass are expected here
 
@@ -139,7 +129,7 @@ def main() -> None:
         rows.append([name + (" (reference)" if name == "sim" else ""), ms.get("detector", "-"), ms.get("masks", "-"),
                      ms["fusion"], ms["tracking"], f"{1000 * total / n:.1f}", f"{n / total:.1f}", f"{n / wall:.1f}",
                      f"{n_det / n:.1f}", str(n_obj)])
-    _table(f"mapping {len(frames)} frames at {w}x{h}, one thread (CPU ms per frame; target >= 5 frames/s)",
+    table(f"mapping {len(frames)} frames at {w}x{h}, one thread (CPU ms per frame; target >= 5 frames/s)",
            ["detector", "model", "masks", "encoder+fusion", "lift+track", "total", "frames/s CPU", "frames/s wall",
             "detections/frame", "objects"], rows)
     print(f"\nload average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores "

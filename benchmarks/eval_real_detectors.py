@@ -36,17 +36,7 @@ from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-REPO = Path(__file__).resolve().parents[1]
-FOLDERS = {"yolo-fastest": "yolo-fastest-1.1-xl", "centernet": "centernet-mobilenetv3-coco"}
-
-
-def _table(title: str, header: list[str], rows: list[list[str]]) -> None:
-    widths = [max(len(str(r[i])) for r in [header, *rows]) for i in range(len(header))]
-    print(f"\n## {title}")
-    print("  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True)))
-    print("  ".join("-" * w for w in widths))
-    for r in rows:
-        print("  ".join(str(c).ljust(w) for c, w in zip(r, widths, strict=True)))
+from bench_common import REPO, WEIGHT_FOLDERS, table  # noqa: E402
 
 
 def make_detector(name: str, weights: Path) -> Any:
@@ -54,7 +44,7 @@ def make_detector(name: str, weights: Path) -> Any:
 
     if name == "sim":
         return create_detector("sim", noise="default", seed=0)
-    return create_detector(name, model_dir=str(weights / FOLDERS[name]), threads=1)
+    return create_detector(name, model_dir=str(weights / WEIGHT_FOLDERS[name]), threads=1)
 
 
 def score(cmap: Any, manifest: Any, seen: dict[int, int], counts: dict[str, dict[str, float]],
@@ -97,7 +87,7 @@ def main() -> None:
     ap.add_argument("--assets-dir", type=Path, default=None)
     ap.add_argument("--weights", type=Path, default=Path(os.environ.get("CAPNAV_SHARED", REPO.parent / "shared"))
                     / "weights")
-    ap.add_argument("--detectors", nargs="+", default=["sim", *FOLDERS], choices=["sim", *FOLDERS])
+    ap.add_argument("--detectors", nargs="+", default=["sim", *WEIGHT_FOLDERS], choices=["sim", *WEIGHT_FOLDERS])
     ap.add_argument("--stride", type=int, default=1, help="map every k-th frame")
     args = ap.parse_args()
     dataset = importlib.import_module("sh3d_data").dataset  # beside this script
@@ -142,7 +132,7 @@ def main() -> None:
             rows.append([c if d == args.detectors[0] else "", d, pct(k["found"], k["seen"]),
                          pct(k["labelled_on"], k["labelled"]), pct(k["dups"], k["on"]), pct(k["right"], k["on"]),
                          f"{100 * np.median(s):.0f} cm" if s else "-"])
-    _table(f"per COCO-covered category, Sweet Home 3D apartments (seeds {' '.join(map(str, args.seeds))}, "
+    table(f"per COCO-covered category, Sweet Home 3D apartments (seeds {' '.join(map(str, args.seeds))}, "
            f"{args.width}x{args.height}, every {args.stride}th frame)",
            ["category", "detector", "recall (seen)", "precision", "duplicates", "category acc.", "size error"], rows)
     rows = []
@@ -154,7 +144,7 @@ def main() -> None:
                      pct(allk["labelled_on"], allk["labelled"]), pct(allk["dups"], allk["on"]),
                      pct(allk["right"], allk["on"]), str(int(t["merged"])),
                      f"{t['frames'] / max(t['seconds'], 1e-9):.1f}"])
-    _table("all COCO-covered categories pooled", ["detector", "objects", "recall", "precision", "duplicates",
+    table("all COCO-covered categories pooled", ["detector", "objects", "recall", "precision", "duplicates",
                                                  "category acc.", "merged at export", "frames/s (CPU)"], rows)
 
 

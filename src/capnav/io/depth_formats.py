@@ -28,7 +28,7 @@ DEPTH_ENCODINGS = ("tum", "nyu", "sun")
 _PGM = re.compile(rb"P5\s+(?:#[^\n]*\n\s*)*(\d+)\s+(?:#[^\n]*\n\s*)*(\d+)\s+(?:#[^\n]*\n\s*)*(\d+)\s")
 
 
-def _png16(path: Path) -> NDArray[np.uint16]:
+def read_png16(path: Path) -> NDArray[np.uint16]:
     try:
         with Image.open(path) as im:
             if im.mode not in ("I;16", "I;16B", "I;16L", "I"):
@@ -69,9 +69,9 @@ def decode_depth(path: str | Path, encoding: str, scale: float = 5000.0) -> NDAr
     if encoding == "tum":
         if not np.isfinite(scale) or scale <= 0:
             raise InputError(f"depth scale must be > 0 units per metre, got {scale}")
-        return (_png16(p).astype(np.float32) / np.float32(scale)).astype(np.float32)
+        return (read_png16(p).astype(np.float32) / np.float32(scale)).astype(np.float32)
     if encoding == "sun":
-        v = _png16(p)
+        v = read_png16(p)
         mm = ((v >> 3) | (v << 13)).astype(np.uint16)
         return (mm.astype(np.float32) / np.float32(1000.0)).astype(np.float32)
     if encoding == "nyu":

@@ -27,6 +27,7 @@ from PIL import Image
 from capnav.core.errors import InputError
 from capnav.core.geometry import Intrinsics
 from capnav.io.assoc import PoseTrack, SkipLog, match_nearest, poses_from_quat
+from capnav.io.depth_formats import read_png16
 from capnav.io.importer import PlannedFrame
 
 #: Published calibration of the three Kinects of the benchmark (640x480), from the dataset's
@@ -109,16 +110,8 @@ def read_rgb(path: Path) -> NDArray[np.uint8]:
 
 
 def read_depth(path: Path, scale: float) -> NDArray[np.float32]:
-    try:
-        with Image.open(path) as im:
-            if im.mode not in ("I;16", "I;16B", "I;16L", "I"):
-                raise InputError(f"depth image {path} has mode {im.mode}, expected 16-bit grey")
-            raw = np.asarray(im)
-    except FileNotFoundError:
-        raise InputError(f"missing depth image {path}") from None
-    except (OSError, SyntaxError, ValueError) as e:
-        raise InputError(f"corrupt depth image {path}: {e}") from None
-    return (raw.astype(np.float32) / np.float32(scale)).astype(np.float32)
+    """A 16-bit depth PNG in metres (``scale`` units per metre, TUM's 5000)."""
+    return (read_png16(path).astype(np.float32) / np.float32(scale)).astype(np.float32)
 
 
 class TumReader:

@@ -10,7 +10,6 @@ imports sentence-transformers).
 
 from __future__ import annotations
 
-import hashlib
 import importlib.util
 import json
 import os
@@ -20,20 +19,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from capnav.core.checksum import sha256_file
 from capnav.core.errors import ModelError
 from capnav.language.embedder import EMBEDDERS, TextEmbedder
 
 MINILM_MODEL_SHA256 = "8199be6f699a395f99f89df973f9dc5285fbcfcdb2ae1a4e1201dab014f3d2a6"
 MINILM_TOKENIZER_SHA256 = "be50c3628f2bf5bb5e3a7f17b1f74611b2561a3a27eeab05e5aa30f411572037"
 MINILM_MODEL_ID = "all-MiniLM-L6-v2-onnx-int8"
-
-
-def sha256_file(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
 
 
 def package_dir(module: str) -> Path:

@@ -12,7 +12,6 @@ crash inside the inference runtime.
 
 from __future__ import annotations
 
-import hashlib
 import os
 import shutil
 import tempfile
@@ -23,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from capnav.core.atomic import write_json
+from capnav.core.checksum import sha256_file
 from capnav.core.errors import InputError, ModelError
 
 RECORD = "capnav-model.json"
@@ -104,14 +104,6 @@ def models_root(root: str | Path | None = None) -> Path:
         return Path(root).expanduser()
     env = os.environ.get("CAPNAV_MODELS")
     return Path(env).expanduser() if env else Path.home() / ".cache" / "capnav" / "models"
-
-
-def sha256_file(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
 
 
 def verify(s: ModelSpec, folder: Path) -> None:
