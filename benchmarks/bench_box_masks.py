@@ -35,7 +35,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 
-from bench_common import table  # noqa: E402
+from bench_common import add_sh3d_args, table  # noqa: E402
 from capnav.core.categories import BY_ID  # noqa: E402
 from capnav.core.frame import Frame  # noqa: E402
 from capnav.perception.base import Detection, Detector  # noqa: E402
@@ -129,11 +129,7 @@ def map_sizes(data: Path, method: str, pad: float, stride: int) -> dict[str, lis
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
-    ap.add_argument("--width", type=int, default=640)
-    ap.add_argument("--height", type=int, default=480)
-    ap.add_argument("--cache", type=Path, default=Path("data/bench"))
-    ap.add_argument("--assets-dir", type=Path, default=None)
+    add_sh3d_args(ap)
     ap.add_argument("--view-stride", type=int, default=3)
     ap.add_argument("--map-stride", type=int, default=1)
     ap.add_argument("--pad", type=float, default=0.05)

@@ -3,6 +3,7 @@ weights, and the plain-text table every script prints (a title, aligned columns)
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
@@ -18,3 +19,12 @@ def table(title: str, header: list[str], rows: list[list[str]]) -> None:
     print("  ".join("-" * w for w in widths))
     for r in rows:
         print("  ".join(str(c).ljust(w) for c, w in zip(r, widths, strict=True)))
+
+
+def add_sh3d_args(ap: argparse.ArgumentParser) -> None:
+    """The options of scripts that render Sweet Home 3D apartments once and cache them."""
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    ap.add_argument("--width", type=int, default=640)
+    ap.add_argument("--height", type=int, default=480)
+    ap.add_argument("--cache", type=Path, default=Path("data/bench"))
+    ap.add_argument("--assets-dir", type=Path, default=None)

@@ -36,7 +36,7 @@ from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from bench_common import REPO, WEIGHT_FOLDERS, table  # noqa: E402
+from bench_common import REPO, WEIGHT_FOLDERS, add_sh3d_args, table  # noqa: E402
 
 
 def make_detector(name: str, weights: Path) -> Any:
@@ -80,11 +80,7 @@ def score(cmap: Any, manifest: Any, seen: dict[int, int], counts: dict[str, dict
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
-    ap.add_argument("--width", type=int, default=640)
-    ap.add_argument("--height", type=int, default=480)
-    ap.add_argument("--cache", type=Path, default=Path("data/bench"))
-    ap.add_argument("--assets-dir", type=Path, default=None)
+    add_sh3d_args(ap)
     ap.add_argument("--weights", type=Path, default=Path(os.environ.get("CAPNAV_SHARED", REPO.parent / "shared"))
                     / "weights")
     ap.add_argument("--detectors", nargs="+", default=["sim", *WEIGHT_FOLDERS], choices=["sim", *WEIGHT_FOLDERS])

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from capnav.core.frame import Frame
@@ -101,3 +103,17 @@ class SquareReader:
             out.append(Observation(i, b, int((b[2] - b[0]) * (b[3] - b[1])), 0.9, "sofa", 2.0,
                                    truncated=b[0] <= 0 or b[2] >= 159, visibility=1.0))
         return out
+
+
+def described_living_map(folder: Path) -> Path:
+    """The living scene (a wall with a door at x = 3.8) captioned offline, embedded with MiniLM
+    and saved as ``folder/living.capnav``: the map the API and server tests read."""
+    from capnav.api import CapNav
+    from capnav.language import create_captioner, create_embedder
+    from capnav.language.describe import describe_map
+
+    cmap = make_map(living_scene(), grid_with_wall(-1, -1, 9, 7, wall_x=3.8, door=(2.5, 3.5)))
+    describe_map(cmap, None, create_captioner("offline"), create_embedder("minilm"), progress=False)
+    path = folder / "living.capnav"
+    CapNav(cmap).save(path)
+    return path
