@@ -94,8 +94,20 @@ def _fail(kind: str, message: str, code: int) -> None:
     sys.exit(code)
 
 
+def stop_on_sigterm() -> None:
+    """Treat SIGTERM (``kill``, a service manager, a CI timeout) like Ctrl-C, so the same clean-up
+    runs: ``eval`` terminates its worker processes instead of leaving them running as orphans."""
+    import signal
+
+    def _raise(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, _raise)
+
+
 def main() -> None:
     """Entry point: expected failures become one red line and exit code 2, not a traceback."""
+    stop_on_sigterm()
     try:
         code = app(standalone_mode=False)
     except Interrupted as e:
