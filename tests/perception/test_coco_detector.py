@@ -22,7 +22,8 @@ from capnav.io.depth_formats import decode_depth
 from capnav.io.tum import read_rgb
 from capnav.perception import DETECTORS, create_detector, validate_detections
 from capnav.perception.coco import COCO80, KEPT_AS_IS, TO_CAPNAV, class_table, coco_label
-from capnav.perception.coco_detector import fit_to_square, per_class_nms
+from capnav.perception.coco_detector import fit_to_square
+from capnav.perception.nms import per_class_nms
 
 BACKENDS = {"yolo-fastest": "yolo-fastest-1.1-xl", "centernet": "centernet-mobilenetv3-coco"}
 PRIMESENSE = Intrinsics(525.0, 525.0, 319.5, 239.5, 640, 480)

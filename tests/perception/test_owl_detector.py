@@ -31,7 +31,8 @@ from capnav.perception.box_masks import (
     grow_smooth,
     nearest_depth_mode,
 )
-from capnav.perception.owl_detector import batched_nms, nms, parse_vocabulary, vocabulary_labels
+from capnav.perception.nms import nms
+from capnav.perception.owl_detector import batched_nms, parse_vocabulary, vocabulary_labels
 
 torch = pytest.importorskip("torch")
 transformers = pytest.importorskip("transformers")

@@ -35,21 +35,9 @@ from capnav.perception.base import DETECTORS, Detection, Detector
 from capnav.perception.box_masks import depth_box_masks, filled_box_mask, floor_pixels
 from capnav.perception.coco import COCO80, class_table
 from capnav.perception.model_store import locate
-from capnav.perception.owl_detector import nms
+from capnav.perception.nms import per_class_nms
 
 COCO_MASK_MODES = ("depth", "box")
-
-
-def per_class_nms(boxes: NDArray[np.floating], scores: NDArray[np.floating], classes: NDArray[np.integer],
-                  iou_threshold: float) -> NDArray[np.int64]:
-    """Per-class NMS in numpy: each class's boxes are shifted far from the others', so one greedy
-    NMS never lets two classes suppress each other. Kept indices, best score first."""
-    b = np.asarray(boxes, dtype=np.float64).reshape(-1, 4)
-    if b.shape[0] == 0:
-        return np.zeros(0, dtype=np.int64)
-    span = float(np.abs(b).max()) + 1.0
-    shifted = b + (np.asarray(classes, dtype=np.float64).ravel() * 2.0 * span)[:, None]
-    return nms(shifted, scores, iou_threshold)
 
 
 def fit_to_square(rgb: NDArray[np.uint8], side: int, letterbox: bool

@@ -35,35 +35,11 @@ from capnav.core.errors import FrameError, InputError, ModelError
 from capnav.core.frame import Frame
 from capnav.perception.base import DETECTORS, Detection, Detector
 from capnav.perception.box_masks import depth_box_masks, filled_box_mask, floor_pixels
+from capnav.perception.nms import per_class_nms
 
 MASK_MODES = ("depth", "sam", "box")
 OWL_MODEL_TYPES = ("owlvit", "owlv2")
 _EXTRA_HINT = "pip install 'capnav[detect]'"
-
-
-def nms(boxes: NDArray[np.floating], scores: NDArray[np.floating], iou_threshold: float) -> NDArray[np.int64]:
-    """Greedy non-maximum suppression; indices of the kept boxes, best score first.
-
-    Ties in score keep the lower index first (stable sort), so the result is deterministic.
-    """
-    b = np.asarray(boxes, dtype=np.float64).reshape(-1, 4)
-    s = np.asarray(scores, dtype=np.float64).ravel()
-    if b.shape[0] != s.shape[0]:
-        raise InputError(f"nms got {b.shape[0]} boxes but {s.shape[0]} scores")
-    order = np.argsort(-s, kind="stable")
-    area = np.clip(b[:, 2] - b[:, 0], 0, None) * np.clip(b[:, 3] - b[:, 1], 0, None)
-    keep: list[int] = []
-    while order.size:
-        i = int(order[0])
-        keep.append(i)
-        rest = order[1:]
-        iw = np.clip(np.minimum(b[i, 2], b[rest, 2]) - np.maximum(b[i, 0], b[rest, 0]), 0, None)
-        ih = np.clip(np.minimum(b[i, 3], b[rest, 3]) - np.maximum(b[i, 1], b[rest, 1]), 0, None)
-        inter = iw * ih
-        union = area[i] + area[rest] - inter
-        iou = np.where(union > 0, inter / np.where(union > 0, union, 1.0), 0.0)
-        order = rest[iou <= iou_threshold]
-    return np.array(keep, dtype=np.int64)
 
 
 def batched_nms(boxes: NDArray[np.floating], scores: NDArray[np.floating], classes: NDArray[np.integer],
@@ -71,7 +47,8 @@ def batched_nms(boxes: NDArray[np.floating], scores: NDArray[np.floating], class
     """Per-class NMS: boxes of different classes never suppress each other. Kept indices, best first.
 
     Uses ``torchvision.ops.batched_nms`` when torchvision imports and works with the installed
-    torch; otherwise the numpy ``nms`` above (same result up to the order of exact score ties).
+    torch; otherwise ``capnav.perception.nms.per_class_nms`` (same result up to the order of exact
+    score ties).
     """
     b = np.asarray(boxes, dtype=np.float64).reshape(-1, 4)
     s = np.asarray(scores, dtype=np.float64).ravel()
@@ -83,10 +60,7 @@ def batched_nms(boxes: NDArray[np.floating], scores: NDArray[np.floating], class
     tv = _torchvision_batched_nms()
     if tv is not None:
         return tv(b, s, c, iou_threshold)
-    # Offsetting each class far apart turns per-class NMS into one NMS (boxes never overlap across classes).
-    span = float(np.abs(b).max()) + 1.0
-    shifted = b + (c.astype(np.float64) * 2.0 * span)[:, None]
-    return nms(shifted, s, iou_threshold)
+    return per_class_nms(b, s, c, iou_threshold)
 
 
 @functools.cache
