@@ -36,6 +36,15 @@ def test_install_from_folder_and_list(name: str, shared_dir: Path, tmp_path: Pat
     assert ms.locate(name, root=tmp_path) == out
 
 
+def test_install_from_a_folder_of_models(shared_dir: Path, tmp_path: Path) -> None:
+    """``--from ../shared/weights`` (one subfolder per model) finds the model's own subfolder."""
+    name = "centernet-mobilenetv3-coco"
+    out = ms.install(name, root=tmp_path, source_dir=shared_dir / "weights")
+    assert ms.locate(name, root=tmp_path) == out
+    with pytest.raises(ModelError, match="is missing"):  # a folder with neither the files nor a subfolder
+        ms.install(name, root=tmp_path, source_dir=shared_dir / "realdata")
+
+
 def test_detector_finds_the_installed_model(shared_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("CAPNAV_MODELS", str(tmp_path))
     r = CliRunner().invoke(app, ["models", "install", "yolo-fastest-1.1-xl", "--from",

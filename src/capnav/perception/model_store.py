@@ -144,6 +144,8 @@ def install(name: str, root: str | Path | None = None, source_dir: str | Path | 
     src = Path(source_dir).expanduser() if source_dir is not None else None
     if src is not None and not src.is_dir():
         raise InputError(f"--from {str(source_dir)!r} is not an existing folder")
+    if src is not None and not (src / s.files[0].name).is_file() and (src / name).is_dir():
+        src = src / name  # a folder of several models, one subfolder each (like ../shared/weights)
     dest_root = models_root(root)
     try:
         dest_root.mkdir(parents=True, exist_ok=True)
