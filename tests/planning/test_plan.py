@@ -142,9 +142,11 @@ def test_goal_prefers_the_near_side_of_a_wall() -> None:
     # An object right behind a wall: within 1 m through the wall, but the robot must walk round.
     occ = wall_with_gap(1.0)
     obj = np.array([[3.2, 0.5], [3.6, 0.5], [3.6, 0.9], [3.2, 0.9]])
-    goal = select_goal(occ, obj, (1.0, 0.5))
+    goal = select_goal(occ, obj, (1.0, 0.5), PlannerConfig(prefer_line_of_sight=False))
     assert goal.reached_within_reach
-    assert goal.xy[0] < 3.0  # the cheaper cell on the robot's side of the wall
+    assert goal.xy[0] < 3.0  # the paper's rule: the cheaper cell on the robot's side of the wall
+    seen = select_goal(occ, obj, (1.0, 0.5))
+    assert seen.reached_within_reach and seen.xy[0] > 3.0  # by default: round the wall, in sight of it
 
 
 def test_bad_footprint() -> None:

@@ -12,13 +12,17 @@ class PlannerConfig:
     """How goals are chosen, how A* weighs the map and how the agent executes a path.
 
     ``reach`` is the paper's 1 m success radius around the goal instance. Goal selection aims a
-    little inside it (``goal_margin``) so a slightly wrong mapped footprint still counts as reached.
+    little inside it (``goal_margin``) so a slightly wrong mapped footprint still counts as reached,
+    and (``prefer_line_of_sight``) at a cell that sees the object when one within reach does.
     """
 
     robot_radius: float = 0.2  # m, the agent's base radius (the simulator agent's default)
     safety_margin: float = 0.05  # m, added to the radius when obstacles are inflated
     reach: float = 1.0  # m, success radius around the object's footprint
     goal_margin: float = 0.3  # m, aim at cells within reach - goal_margin when possible
+    # Among cells within reach, prefer those that see the object on the map (planning/sight.py);
+    # False keeps the paper's rule: the nearest cell within reach, wall or no wall.
+    prefer_line_of_sight: bool = True
     # Weight of an unknown cell (None = blocked). 5 from a sweep with benchmarks/eval_reach.py on sparse
     # (20-frame, noisy-depth) maps: blocked 82.8%, 1.5 98.1%, 3 98.9%, 5 100%, 10 100% reached.
     unknown_cost: float | None = 5.0

@@ -2,7 +2,9 @@
 
 The paper turns the object's cell into a waypoint; an object's own cell is an obstacle, so we pick
 the free cell nearest to the robot (by path cost) among those within the reach radius of the
-footprint, aiming ``goal_margin`` inside it when possible, and face the object from there.
+footprint, aiming ``goal_margin`` inside it when possible, and face the object from there. Within
+1 m of an object may lie behind its wall, so cells that see the object on the map come first
+(``PlannerConfig.prefer_line_of_sight``, see :mod:`capnav.planning.sight`).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from capnav.core.grid import OccupancyGrid
 from capnav.planning.config import PlannerConfig
 from capnav.planning.costmap import Costmap, build_costmap, locate_start
 from capnav.planning.search import cost_field
+from capnav.planning.sight import sees_footprint
 
 
 @dataclass(frozen=True)
@@ -54,6 +57,9 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
     """Nearest reachable free cell within ``config.reach`` of the footprint (preferring
     ``reach - goal_margin``); else the reachable cell closest to the object, with the reason.
 
+    With ``config.prefer_line_of_sight`` the same two tiers are first tried among the cells that
+    see the footprint on the map; when none within reach does, the reason says so.
+
     Raises ``NotFoundError`` when nothing at all is reachable from the start.
     """
     cfg = config or PlannerConfig()
@@ -74,11 +80,23 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
     tiers = ((cfg.reach - cfg.goal_margin, "the nearest reachable free cell {d:.2f} m from the object"),
              (cfg.reach, "the nearest reachable free cell within reach ({d:.2f} m from the object; none "
                          f"within {cfg.reach - cfg.goal_margin:.2f} m)"))
+    within = np.nonzero(dist <= cfg.reach)[0]
+    blind = ""
+    if cfg.prefer_line_of_sight and within.size:
+        seen = np.zeros(len(rc), dtype=bool)
+        seen[within] = sees_footprint(cm.occ, fp, rc[within], polygon_centroid(fp))
+        for limit, why in tiers:
+            ok = np.nonzero(seen & (dist <= limit))[0]
+            if ok.size:
+                i = int(ok[np.argmin(cost[ok])])
+                return _pose(rc[i], centres[i], fp, True, why.format(d=dist[i]) + ", in sight of it on the map",
+                             float(dist[i]), float(cost[i]))
+        blind = f"; none of the {within.size} reachable cells within reach sees the object on the map"
     for limit, why in tiers:
         ok = np.nonzero(dist <= limit)[0]
         if ok.size:
             i = int(ok[np.argmin(cost[ok])])
-            return _pose(rc[i], centres[i], fp, True, why.format(d=dist[i]), float(dist[i]), float(cost[i]))
+            return _pose(rc[i], centres[i], fp, True, why.format(d=dist[i]) + blind, float(dist[i]), float(cost[i]))
     if len(rc) == 0:  # pragma: no cover - the start cell itself is always reachable
         raise NotFoundError("no cell is reachable from the start")
     dist = _distances(centres, fp)
