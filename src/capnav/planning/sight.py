@@ -59,10 +59,16 @@ def sees_footprint(occ: OccupancyGrid, footprint: NDArray[np.float64], cells: ND
     fp_rc = spec.to_cell(np.vstack([footprint, centroid[None, :]]))
     lo = np.maximum(np.minimum(cells.min(axis=0), fp_rc.min(axis=0)), 0)
     hi = np.minimum(np.maximum(cells.max(axis=0), fp_rc.max(axis=0)), [spec.rows - 1, spec.cols - 1])
-    rr, cc = np.mgrid[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1]
-    centres = spec.to_world(np.stack([rr.ravel(), cc.ravel()], axis=1))
-    own = (footprint_distance(centres, footprint) <= 0.5 * spec.resolution + 1e-9).reshape(rr.shape)
     window = occ.cells[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1]
+    own = np.zeros(window.shape, dtype=bool)
+    # The object's own cells lie in its box grown by half a cell: measure only those.
+    half = 0.5 * spec.resolution
+    a = np.maximum(spec.to_cell(footprint.min(axis=0) - half), lo)
+    b = np.minimum(spec.to_cell(footprint.max(axis=0) + half), hi)
+    if (a <= b).all():
+        rr, cc = np.mgrid[a[0]:b[0] + 1, a[1]:b[1] + 1]
+        centres = spec.to_world(np.stack([rr.ravel(), cc.ravel()], axis=1))
+        own[rr - lo[0], cc - lo[1]] = (footprint_distance(centres, footprint) <= half + 1e-9).reshape(rr.shape)
     w = np.where((window == OCCUPIED) & ~own, np.inf, 0.0)
     targets = _targets(own, spec.to_cell(centroid) - lo, w.shape)
     return _sees(np.ascontiguousarray(w), np.ascontiguousarray(cells - lo), targets)
