@@ -225,3 +225,30 @@ def test_hallway_words_name_a_room_not_an_unknown_word(text, cat):
     q = parse_instruction(text)
     assert q.room == "hallway" and q.category == cat
     assert not {"hall", "hallway", "corridor"} & set(q.unknown_words)
+
+
+@pytest.mark.parametrize(("text", "cat", "relation", "anchors", "room"), [
+    ("the lamp between the blue sofa and the red armchair", "lamp", "between", ("sofa", "armchair"), None),
+    ("go to the stool in between the fridge and the cooker", "stool", "between", ("refrigerator", "stove"), None),
+    ("the stool at the end of the kitchen counter", "stool", "at the end of", ("counter", None), None),
+    ("the armchair facing the telly", "armchair", "facing", ("tv", None), None),
+    ("the nightstand in the room with the green wardrobe", "nightstand", "in the room with", ("wardrobe", None), None),
+    ("the plant in the office that has the black desk", "plant", "in the room with", ("desk", None), "office"),
+])
+def test_relations_with_geometry_of_their_own(text, cat, relation, anchors, room):
+    q = parse_instruction(text)
+    assert (q.category, q.relation, q.anchor_category, q.anchor2_category, q.room) == (cat, relation, *anchors, room)
+    assert not q.colors  # the landmarks' colours are theirs, not the target's
+
+
+@pytest.mark.parametrize(("text", "cat"), [
+    ("the coffe tabel", "coffee table"), ("the lounge chiar", "armchair"),
+    # a misspelt target before an exactly spelt landmark is still the target
+    ("the dreser in the room with the blue bed", "dresser"),
+])
+def test_misspelt_multi_word_names(text, cat):
+    assert parse_instruction(text).category == cat
+
+
+def test_a_multi_word_typo_needs_words_that_are_no_english_words():
+    assert parse_instruction("the washing line").category is None  # not "washing machine"

@@ -29,6 +29,11 @@ class RetrievalConfig:
     min_score: float = 0.30  # "not found" below this cosine when not verifying
     grid_resolution: float = 0.05  # m, used when the map has no grid (eq. 17's s)
     runners_up: int = 5
+    #: "not the yellow lamp": a negated colour names the instance(s) that fit it best, as a
+    #: definite description does; candidates whose colour agreement is at least this share of the
+    #: best one's are excluded too (a paler fit is "the other one": a light grey machine is not
+    #: "the white washing machine" when a white one stands in the map).
+    negation_contrast: float = 0.75
 
     def __post_init__(self) -> None:
         if self.top_k < 1 or self.batch_size < 1 or self.max_batches < 1:

@@ -23,6 +23,8 @@ import unicodedata
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from rapidfuzz import fuzz, process
+
 from capnav.core.categories import CATEGORIES
 from capnav.core.errors import InputError
 from capnav.language.colors import ALIASES, LEXICON, SHADES, canonical_color, color_lab
@@ -63,11 +65,15 @@ for _cat in CATEGORIES:
         _FORM_MAP[_f] = _cat.name
         _FORM_MAP.setdefault(_plural(_f), _cat.name)
 _FORM_WORDS = {w for f in _FORM_MAP for w in f.split()}
+_FORM_ALT = "|".join(re.escape(f) for f in sorted(_FORM_MAP, key=len, reverse=True))
 #: Typos are matched against the vocabulary's own words only (not WordNet's 600 rarer ones).
 _TYPO_FORMS = {f: c.name for c in CATEGORIES for f0 in (c.name, *c.synonyms) for f in (f0, _plural(f0))}
 _MULTI_FORMS = sorted(f for f in _TYPO_FORMS if " " in f)
 _SINGLE_FORMS = sorted({f for f in _TYPO_FORMS if " " not in f and len(f) >= 4})
 _TYPO_WORDS = {w for f in _TYPO_FORMS for w in f.split()}
+#: rapidfuzz ratio (0-100) at which a misspelt multi-word name is read as that name: two letters
+#: wrong in "washing machine" (89.7) pass, a different word ("washing line") does not.
+_MULTI_TYPO_SCORE = 86.0
 
 _PROXIMITY = {"closest": "closest", "nearest": "closest", "near me": "closest", "closest to me": "closest",
               "farthest": "farthest", "furthest": "farthest", "most distant": "farthest"}
@@ -79,8 +85,14 @@ _SIZE_WORDS = {"big": "large", "large": "large", "huge": "large", "larger": "lar
 _SHAPES = {"round": "round", "circular": "round", "l-shaped": "L-shaped", "l shaped": "L-shaped",
            "corner": "L-shaped", "long": "long", "rectangular": "rectangular", "square": "square",
            "curved": "curved", "oval": "round"}
-_RELATIONS = ["in front of", "next to", "close to", "beside", "besides", "near", "by", "behind", "opposite",
-              "across from", "alongside", "against"]
+#: Relations whose geometry the retriever measures beyond the gap: "between" two landmarks
+#: (``anchor2_category``), "at the end of" a long object (the ends of its long axis), and
+#: "in the room with" a landmark (its room region).
+BETWEEN = "between"
+END_OF = "at the end of"
+ROOM_WITH = "in the room with"
+_RELATIONS = [END_OF, "in front of", "facing", "next to", "close to", "beside", "besides", "near", "by", "behind",
+              "opposite", "across from", "alongside", "against"]
 _MATERIALS = {"wooden", "wood", "leather", "fabric", "velvet", "metal", "glass", "marble", "plastic",
               "ceramic", "stainless", "steel", "laminate", "cotton", "acrylic", "paper", "terracotta"}
 _FILLER = {"go", "to", "the", "a", "an", "please", "find", "navigate", "take", "me", "walk", "head", "move",
@@ -118,6 +130,8 @@ class ParsedQuery:
     negations: list[str] = field(default_factory=list)  # phrases the target must NOT match ("white")
     ordinal: int | None = None  # 2 for "the second closest"
     proximity_to_anchor: bool = False  # "the chair closest to the table": distance to the anchor
+    anchor2_category: str | None = None  # the second landmark of "between the sofa and the armchair"
+    anchor2_phrase: str | None = None
 
     @property
     def has_attributes(self) -> bool:
@@ -181,12 +195,17 @@ def _find_category(words: list[str]) -> tuple[str | None, tuple[int, int] | None
             gram = " ".join(words[i:i + n])
             if gram in _FORM_MAP:
                 return _FORM_MAP[gram], (i, i + n), False
-    # A typo in a multi-word name ("longe chair") before the exact single word inside it ("chair").
+    # A typo in a multi-word name ("longe chair", "dinning tabel") before the exact single word
+    # inside it ("chair"): rapidfuzz's normalised edit similarity (symmetric, unlike difflib's),
+    # and only when every changed word is no English word of its own ("dining cable" is not a typo).
     for n in (3, 2):
         for i in range(len(words) - n + 1):
-            near = difflib.get_close_matches(" ".join(words[i:i + n]), _MULTI_FORMS, n=1, cutoff=0.88)
-            if near:
-                return _TYPO_FORMS[near[0]], (i, i + n), True
+            part = words[i:i + n]
+            hit = process.extractOne(" ".join(part), _MULTI_FORMS, scorer=fuzz.ratio, score_cutoff=_MULTI_TYPO_SCORE)
+            if hit is not None and len(hit[0].split()) == n and all(
+                    w == f or (w not in _FORM_WORDS and w not in _LEX.not_typos and w not in _ENGLISH_HINTS)
+                    for w, f in zip(part, hit[0].split(), strict=True)):
+                return _TYPO_FORMS[hit[0]], (i, i + n), True
     for i in range(len(words)):
         if words[i] in _FORM_MAP:
             return _FORM_MAP[words[i]], (i, i + 1), False
@@ -310,6 +329,50 @@ def _landmark_proximity(q: ParsedQuery, head: str) -> str:
 _CLAUSE_VERB = re.compile(r"\b(?:is|are|was|were|sits|sit|stands|stand|rests|lies|has\s+been)\b")
 
 
+_ARTICLE = r"(?:the\s+|a\s+|an\s+|my\s+|our\s+|your\s+)?"
+_ROOM_ALT = "|".join(re.escape(r) for r in sorted(ROOM_SYNONYMS, key=len, reverse=True))
+
+
+def _landmark(words: list[str]) -> tuple[str, str, list[str]] | None:
+    """(category, phrase up to its noun, the words after it) of a landmark phrase, else None."""
+    cat, span, _ = _find_category(words)
+    if cat is None or span is None:
+        return None
+    return cat, " ".join(words[: span[1]]), words[span[1]:]
+
+
+def _room_with(q: ParsedQuery, head: str) -> str:
+    """"in the room with the pink dresser", "in the bedroom that has the yellow bed": the target
+    stands in the landmark's room (``ROOM_WITH``); a named room type is kept as the room too.
+    Returns ``head`` without the clause."""
+    m = re.search(rf"\b(?:in|inside|within)\s+{_ARTICLE}(?P<room>{_ROOM_ALT}|room)\s+(?:with|that\s+has|which\s+has"
+                  rf"|where\s+there\s+is|containing)\s+{_ARTICLE}(?P<anchor>.+)$", head)
+    if not m:
+        return head
+    found = _landmark(m.group("anchor").split())
+    if found is None:
+        return head
+    q.relation, q.anchor_category, q.anchor_phrase = ROOM_WITH, found[0], found[1]
+    if m.group("room") != "room":
+        q.room = ROOM_SYNONYMS[m.group("room")]
+    return " ".join([head[: m.start()], *found[2]]).strip()
+
+
+def _between(q: ParsedQuery, head: str) -> str:
+    """"the table between the green sofa and the purple armchair": two landmarks, each with its
+    own words. Returns ``head`` without them."""
+    m = re.search(rf"\b(?:in\s+)?between\s+{_ARTICLE}(?P<a>.+?)\s+and\s+{_ARTICLE}(?P<b>.+)$", head)
+    if not m or m.start() == 0:
+        return head
+    first, second = _landmark(m.group("a").split()), _landmark(m.group("b").split())
+    if first is None or second is None or first[2]:
+        return head
+    q.relation = BETWEEN
+    q.anchor_category, q.anchor_phrase = first[0], first[1]
+    q.anchor2_category, q.anchor2_phrase = second[0], second[1]
+    return " ".join([head[: m.start()], *second[2]]).strip()
+
+
 def _clause_landmark(q: ParsedQuery, head: str) -> str:
     """"the desk the pink chair is pulled up to", "the table that the green lamp stands beside":
     a second noun phrase after the target, followed by a verb, is a landmark next to the target;
@@ -383,9 +446,13 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> Parsed
     norm = " ".join(_fix_keyword_typos(norm.replace("'s", "").split()))
     q = ParsedQuery(text=t)
     head = _negations(q, norm)
+    # "the bed in the room with the pink dresser", "the wardrobe in the bedroom with the yellow bed".
+    head = _room_with(q, head)
     # Room: "in the kitchen", "in the living room".
     for phrase in sorted(ROOM_SYNONYMS, key=len, reverse=True):
-        m = re.search(rf"\b(?:in|inside|within|from|of)\s+(?:the\s+|my\s+|our\s+)?{re.escape(phrase)}\b", head)
+        # Not when the room word modifies an object noun ("at the end of the kitchen counter").
+        m = re.search(rf"\b(?:in|inside|within|from|of)\s+(?:the\s+|my\s+|our\s+)?{re.escape(phrase)}\b"
+                      rf"(?!\s+(?:{_FORM_ALT})\b)", head)
         if m:
             q.room = ROOM_SYNONYMS[phrase]
             head = (head[:m.start()] + " " + head[m.end():]).strip()
@@ -411,6 +478,9 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> Parsed
     # A landmark clause: "the desk the pink chair is pulled up to".
     if q.anchor_category is None:
         head = _clause_landmark(q, head)
+    # "the table between the sofa and the armchair": two landmarks.
+    if q.anchor_category is None:
+        head = _between(q, head)
     # Relation: "<target> next to the <anchor>".
     if q.anchor_category is None:
         for rel in _RELATIONS:

@@ -26,15 +26,14 @@ from capnav.language.prompts import caption_name
 from capnav.mapping.cmap import CapNavMap
 from capnav.mapping.objects import MapObject
 from capnav.retrieval.config import RetrievalConfig
-from capnav.retrieval.query import ParsedQuery, parse_instruction
+from capnav.retrieval.query import BETWEEN, END_OF, ROOM_WITH, ParsedQuery, parse_instruction
 from capnav.retrieval.ranking import cosine_scores, mmr, top_k
 from capnav.retrieval.result import QueryResult
+from capnav.retrieval.spatial import end_distance, has_long_axis, segment_distance
 from capnav.retrieval.verifier import AcceptFirst, Assessment, Candidate, OfflineVerifier, Verifier, a
 
 _VOCAB = set(NAMES)
 _ROOMS = list(ROOM_CUES)
-#: The relation of "the bed in the room with the pink dresser" (ParsedQuery.relation).
-ROOM_WITH = "in the room with"
 _ORDINALS = {2: "second", 3: "third", 4: "fourth", 5: "fifth"}
 
 
@@ -133,45 +132,65 @@ class Retriever:
             w[self._of_category(q.category)] = 1.0
         return w
 
-    def _negated(self, q: ParsedQuery, i: int) -> str | None:
-        """The negation phrase object ``i`` matches ("not the white one"), else None."""
-        o = self.objects[i]
+    def _excluded(self, q: ParsedQuery, pool: NDArray[np.intp], weights: NDArray[np.float64]) -> dict[int, str]:
+        """Candidates of ``pool`` a negation names ("not the white one"), with the phrase.
+
+        A negated colour is read as a definite description among the candidates: it names the
+        ones that fit it best (agreement at least ``color_reject``, and at least
+        ``negation_contrast`` of the best fit among the named category's candidates), not every
+        candidate that is somewhat that colour; so "not the yellow lamp, the other one" excludes
+        the mustard lamp although its agreement is below ``color_match``, and "not the white
+        washing machine" keeps the light grey one when a white one stands beside it."""
+        out: dict[int, str] = {}
+        named = pool[weights[pool] >= 1.0]
+        ref = named if len(named) else pool
         for phrase in q.negations:
             try:
                 nq = parse_instruction(phrase)
             except InputError:
                 continue
-            checks: list[bool] = []
             if nq.category is not None and nq.category != q.category and not nq.colors and not nq.room:
                 continue  # "not the one at the end of the table": a relation this reader does not judge
+            fits = np.ones(len(pool), dtype=bool)
+            judged = False
             if nq.category is not None and nq.category == q.category:
-                checks.append(self.cats[i] == nq.category)
+                fits &= self.cats_arr[pool] == nq.category
+                judged = True
             if nq.colors:
-                col, _ = self.judge.color(nq, o)
-                checks.append(col >= self.judge.config.color_match)
+                col = {int(i): self.judge.color(nq, self.objects[int(i)])[0] for i in pool}
+                best = max((col[int(i)] for i in ref), default=0.0)
+                bar = max(self.judge.config.color_reject, self.config.negation_contrast * best)
+                fits &= np.array([col[int(i)] >= bar for i in pool])
+                judged = True
             if nq.room is not None:
-                checks.append(self.scene.rooms[i] == nq.room)
-            if nq.shapes and o.caption:
-                checks.append(all(s.lower() in o.caption.lower() for s in nq.shapes))
-            if checks and all(checks):
-                return phrase
-        return None
+                fits &= np.array([self.scene.rooms[int(i)] == nq.room for i in pool])
+                judged = True
+            if nq.shapes:
+                fits &= np.array([all(w.lower() in (self.objects[int(i)].caption or "").lower() for w in nq.shapes)
+                                  for i in pool])
+                judged = True
+            if judged:
+                for i in pool[fits]:
+                    out.setdefault(int(i), phrase)
+        return out
 
-    def _anchors(self, q: ParsedQuery, notes: list[str]) -> NDArray[np.intp]:
-        """The landmark's instances, resolved first: of its category, and when its phrase says a
-        colour or a room, only the instance(s) that fit best ("the yellow lamp")."""
-        assert q.anchor_category is not None
-        anchors = self._of_category(q.anchor_category)
-        if len(anchors) < 2 or not q.anchor_phrase:
+    def _anchors(self, q: ParsedQuery, notes: list[str], second: bool = False) -> NDArray[np.intp]:
+        """The landmark's instances (the second landmark's of "between" with ``second``), resolved
+        first: of its category, and when its phrase says a colour or a room, only the instance(s)
+        that fit best ("the yellow lamp")."""
+        category, phrase = (q.anchor2_category, q.anchor2_phrase) if second else (q.anchor_category, q.anchor_phrase)
+        assert category is not None
+        anchors = self._of_category(category)
+        if len(anchors) < 2 or not phrase:
             return anchors
         try:
-            aq = parse_instruction(q.anchor_phrase)
+            aq = parse_instruction(phrase)
         except InputError:
             return anchors
         if aq.colors:
             agree = np.array([self.judge.color(aq, self.objects[k])[0] for k in anchors])
             keep = anchors[agree >= max(self.judge.config.color_reject, agree.max() - 0.05)]
-            notes.append(f"landmark '{q.anchor_phrase}': object {', '.join(str(self.objects[k].id) for k in keep)}")
+            notes.append(f"landmark '{phrase}': object {', '.join(str(self.objects[k].id) for k in keep)}")
             anchors = keep
         if aq.room is not None:
             inroom = anchors[[self.scene.rooms[k] == aq.room for k in anchors]]
@@ -209,14 +228,18 @@ class Retriever:
                 refusal = (f"no {q.category or q.target_phrase} in the map, and nothing else fits "
                            f"'{q.target_phrase}' by what was observed")
         if q.negations and len(pool):
-            neg = {int(i): self._negated(q, int(i)) for i in pool}
-            dropped = [i for i, p in neg.items() if p is not None]
+            neg = self._excluded(q, pool, weights)
+            dropped = list(neg)
             if dropped:
                 notes.append("excluded by the negation: " + ", ".join(
                     f"object {self.objects[i].id} ({neg[i]})" for i in dropped))
-                pool = np.array([i for i in pool if neg[int(i)] is None], dtype=np.intp)
-                if not len(pool):
-                    refusal = f"every candidate matches what the instruction excludes ({'; '.join(q.negations)})"
+                had_named = bool((weights[pool] >= 1.0).any())
+                pool = np.array([i for i in pool if int(i) not in neg], dtype=np.intp)
+                if not len(pool) or (had_named and not (weights[pool] >= 1.0).any()):
+                    # "not the white washer, the other one" presumes another of that category: an
+                    # alternative category ("a fridge can serve as a washer") is no "other one".
+                    refusal = (f"every {q.category or 'candidate'} matches what the instruction excludes "
+                               f"({'; '.join(q.negations)})")
         group_keys: list[NDArray[np.float64]] = [-weights[pool]]
         order_keys: list[NDArray[np.float64]] = []
         predicate: str | None = None
@@ -264,6 +287,25 @@ class Retriever:
                     predicate = f"{ROOM_WITH} the {q.anchor_category}"
                     if not same_room.any() and refusal is None:
                         refusal = f"no {q.category or q.target_phrase} stands in the room with the {q.anchor_phrase}"
+                elif q.relation == BETWEEN and q.anchor2_category is not None \
+                        and len(second := self._anchors(q, notes, True)):
+                    # "the table between the sofa and the armchair": distance to the segment joining
+                    # the two landmarks' centres (the best pair when there are several).
+                    xy = self.scene.xy
+                    line = np.array([min((segment_distance(xy[i], xy[a_], xy[b_]) for a_ in anchors for b_ in second
+                                          if len({int(i), int(a_), int(b_)}) == 3), default=np.inf) for i in pool])
+                    values["distance to the line between the landmarks (m)"] = line
+                    group_keys.append(np.round(line / 0.25))
+                    predicate = f"between the {q.anchor_category} and the {q.anchor2_category}"
+                elif q.relation == END_OF and len(long_ := np.array([k for k in anchors if has_long_axis(
+                        self.objects[k].footprint)], dtype=np.intp)):
+                    # "the chair at the end of the table": distance to the nearer end of the
+                    # landmark's long axis (a round or square landmark has no end: "next to").
+                    ends = np.array([min((end_distance(self.scene.xy[i], self.objects[k].footprint)
+                                          for k in long_ if k != i), default=np.inf) for i in pool])
+                    values["distance to the landmark's end (m)"] = ends
+                    group_keys.append(np.round(ends / 0.25))
+                    predicate = f"{END_OF} the {q.anchor_category}"
                 elif q.proximity_to_anchor and q.proximity is not None:
                     # "the chair closest to the table": distance to the landmark, exactly.
                     centre = np.linalg.norm(self.scene.xy[pool][:, None] - self.scene.xy[anchors][None], axis=2)

@@ -1,0 +1,71 @@
+"""Geometry of the relations that need more than the gap between two boxes: "between" two
+landmarks and "at the end of" a long one.
+
+Why: "the table between the sofa and the armchair" is the object on the line joining the two,
+not the one nearest either; "the chair at the end of the table" sits beyond a short edge of the
+table, not along its long side. Both are measured on what the map observed: object centres and
+the footprint (convex hull of the fused points in x, y).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+#: Below this length / width ratio a footprint has no long axis, so no "end" (a round or square
+#: table): "at the end of" is then read as "next to".
+MIN_ELONGATION = 1.25
+
+
+def segment_distance(p: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
+    """Distance from point ``p`` to the segment ``a``-``b`` (to the nearer end beyond it)."""
+    ab = b - a
+    denom = float(ab @ ab)
+    t = 0.0 if denom == 0.0 else float(np.clip((p - a) @ ab / denom, 0.0, 1.0))
+    return float(np.linalg.norm(p - (a + t * ab)))
+
+
+def oriented_box(footprint: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64], float, float]:
+    """(centre, unit long axis, half length, half width) of the footprint's minimum-area
+    rectangle, searched over the directions of its hull edges (rotating calipers)."""
+    pts = np.asarray(footprint, dtype=np.float64).reshape(-1, 2)
+    if len(pts) < 3:
+        c = pts.mean(axis=0) if len(pts) else np.zeros(2)
+        return c, np.array([1.0, 0.0]), 0.0, 0.0
+    edges = np.diff(np.vstack([pts, pts[:1]]), axis=0)
+    angles = np.unique(np.round(np.arctan2(edges[:, 1], edges[:, 0]) % (np.pi / 2), 6))
+    best: tuple[float, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]] | None = None
+    for th in angles:
+        u = np.array([np.cos(th), np.sin(th)])
+        v = np.array([-u[1], u[0]])
+        pu, pv = pts @ u, pts @ v
+        area = float((pu.max() - pu.min()) * (pv.max() - pv.min()))
+        if best is None or area < best[0] - 1e-12:
+            lo = np.array([pu.min(), pv.min()])
+            hi = np.array([pu.max(), pv.max()])
+            best = (area, u, lo, hi)
+    assert best is not None
+    _, u, lo, hi = best
+    v = np.array([-u[1], u[0]])
+    mid = (lo + hi) / 2
+    centre = mid[0] * u + mid[1] * v
+    half = (hi - lo) / 2
+    if half[1] > half[0]:
+        return centre, v, float(half[1]), float(half[0])
+    return centre, u, float(half[0]), float(half[1])
+
+
+def has_long_axis(footprint: NDArray[np.float64]) -> bool:
+    """Whether the footprint is elongated enough to have ends (``MIN_ELONGATION``)."""
+    _, _, hl, hw = oriented_box(footprint)
+    return hw > 0.0 and hl >= MIN_ELONGATION * hw
+
+
+def end_distance(p: NDArray[np.float64], footprint: NDArray[np.float64]) -> float:
+    """Distance from ``p`` to the nearer end of the footprint's long axis (the middle of a short
+    edge of its minimum-area rectangle)."""
+    centre, u, hl, _ = oriented_box(footprint)
+    return float(min(np.linalg.norm(p - (centre + hl * u)), np.linalg.norm(p - (centre - hl * u))))
+
+
+__all__ = ["MIN_ELONGATION", "end_distance", "has_long_axis", "oriented_box", "segment_distance"]
