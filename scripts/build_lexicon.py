@@ -44,6 +44,12 @@ is spoken to):
   parser turns these into weighted alternative categories.
 - ``glosses``: WordNet's definitions and examples of each category's synsets and their direct
   hyponyms, for requests by purpose ("somewhere to sit" is matched to them with the text embedder).
+- ``sizes``: size adjectives -> "large" / "small" ("king-size", "oversized", "tiny", "bigger",
+  "tinier"): the lemmas of WordNet's adjective clusters around ``large.a.01`` and ``small.a.01``
+  whose most frequent adjective sense lies in the cluster ("deep", "wide", "slim" and "super" are
+  another sense first) and which are not used more often as a noun or verb in WordNet's
+  sense-tagged corpus ("minute", "giant"), with their comparatives from WordNet's exception list
+  (``adj.exc``: bigger, tinier); a hyphenated one also with a space ("king size").
 - ``foreign``: function words of French, Spanish, German, Italian, Portuguese and Dutch (from the
   ``stop-words`` package) that are not English: not an English stop word (scikit-learn's list) and
   not a WordNet lemma
@@ -149,7 +155,41 @@ def _form(lemma: str) -> str:
 def build(wordnet: Path) -> dict[str, Any]:
     with tempfile.TemporaryDirectory() as tmp:
         wn = open_wordnet(wordnet, Path(tmp))
-        return _build(wn)
+        out = _build(wn)
+        out["sizes"] = _sizes(wn, (wordnet / "adj.exc").read_text().splitlines())
+        return out
+
+
+#: The heads of WordNet's size clusters and the size word each stands for.
+SIZE_HEADS = {"large": "large.a.01", "small": "small.a.01"}
+
+
+def _sizes(wn: Any, exceptions: list[str]) -> dict[str, str]:
+    """Size adjectives -> "large" / "small" (see the module docstring)."""
+
+    def count(lemma: str, pos: str) -> int:
+        return sum(lem.count() for s in wn.synsets(lemma, pos) for lem in s.lemmas() if lem.name() == lemma)
+
+    out: dict[str, str] = {}
+    for size, head in SIZE_HEADS.items():
+        cluster = {wn.synset(head), *wn.synset(head).similar_tos()}
+        for lemma in sorted({lem.name() for s in cluster for lem in s.lemmas()}):
+            if lemma != lemma.lower() or "_" in lemma:
+                continue
+            senses = [s for s in wn.synsets(lemma) if s.pos() in "as"
+                      and any(lem.name() == lemma for lem in s.lemmas())]
+            if not senses or senses[0] not in cluster:
+                continue
+            if max(count(lemma, "n"), count(lemma, "v")) > count(lemma, "a"):
+                continue
+            out[lemma] = size
+            if "-" in lemma:
+                out[lemma.replace("-", " ")] = size
+    for line in exceptions:
+        infl, *bases = line.split()
+        if not infl.endswith("est") and any(b in out for b in bases):
+            out.setdefault(infl, out[next(b for b in bases if b in out)])
+    return dict(sorted(out.items()))
 
 
 def _closure(wn: Any, names: list[str], excluded: set[str]) -> set[str]:

@@ -72,3 +72,14 @@ def test_glosses_and_language_words_are_there():
     assert {"the", "to"} <= lex.english
     assert {"store", "write"} <= lex.not_typos
     assert lex.load_seconds < 1.0
+
+
+def test_size_adjectives_come_from_wordnet_s_size_clusters():
+    sizes = load_lexicon().sizes
+    for w in ("king-size", "king size", "oversized", "huge", "bigger"):
+        assert sizes[w] == "large", w
+    for w in ("tiny", "tinier", "petite", "smaller"):
+        assert sizes[w] == "small", w
+    # another sense first ("deep", "wide", "slim") or more often a noun ("minute", "giant")
+    for w in ("deep", "wide", "slim", "minute", "giant", "super"):
+        assert w not in sizes, w

@@ -252,3 +252,12 @@ def test_misspelt_multi_word_names(text, cat):
 
 def test_a_multi_word_typo_needs_words_that_are_no_english_words():
     assert parse_instruction("the washing line").category is None  # not "washing machine"
+
+
+@pytest.mark.parametrize(("text", "size"), [
+    ("the king-size bed", "large"), ("the queen size bed", "large"), ("the oversized armchair", "large"),
+    ("the tinier of the two plants", "small"), ("the bigger lamp", "large"), ("a teeny stool", "small"),
+    ("I need a wee", None), ("move a little", None),  # a size word as a noun
+])
+def test_size_words(text, size):
+    assert parse_instruction(text).size_word == size

@@ -37,6 +37,7 @@ class Lexicon:
     foreign: frozenset[str]  # function words of other languages that are not English words
     english: frozenset[str]  # English function words that no other of those languages uses
     not_typos: frozenset[str]  # common words that look like a category or colour word ("store")
+    sizes: dict[str, str]  # size adjective ("king-size", "tinier") -> "large" / "small"
     load_seconds: float = 0.0
 
     def category_alternatives(self, category: str, form: str | None = None) -> dict[str, float]:
@@ -69,7 +70,7 @@ def load_lexicon() -> Lexicon:
                   other=frozenset(raw.get("other", [])), relations=raw.get("relations", {}),
                   glosses={k: tuple(v) for k, v in raw.get("glosses", {}).items()},
                   foreign=frozenset(raw.get("foreign", [])), english=frozenset(raw.get("english", [])),
-                  not_typos=frozenset(raw.get("not_typos", [])))
+                  not_typos=frozenset(raw.get("not_typos", [])), sizes=dict(raw.get("sizes", {})))
     object.__setattr__(lex, "load_seconds", time.perf_counter() - t0)
     return lex
 

@@ -82,6 +82,9 @@ _SUPERLATIVE = {"biggest": "largest", "largest": "largest", "largest one": "larg
                 "narrowest": "smallest"}
 _SIZE_WORDS = {"big": "large", "large": "large", "huge": "large", "larger": "large", "bigger": "large",
                "small": "small", "little": "small", "tiny": "small", "smaller": "small", "compact": "small"}
+#: WordNet's size adjectives and their comparatives ("king-size", "oversized", "tinier"; the lexicon).
+_SIZE_WORDS.update(_LEX.sizes)
+_SIZE_TOKENS = {w for f in _SIZE_WORDS for w in f.split()}
 _SHAPES = {"round": "round", "circular": "round", "l-shaped": "L-shaped", "l shaped": "L-shaped",
            "corner": "L-shaped", "long": "long", "rectangular": "rectangular", "square": "square",
            "curved": "curved", "oval": "round"}
@@ -499,7 +502,7 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> Parsed
         if re.search(rf"\b{phrase}\b", head):
             q.superlative = _SUPERLATIVE[phrase]
             break
-    q.size_word = next((_SIZE_WORDS[w] for w in words if w in _SIZE_WORDS), None)
+    q.size_word = _size_word(words)
     q.colors = _colors(words)
     if len(q.colors) > 1 and "terracotta" in q.colors:  # "a yellow terracotta pot": a material here
         q.colors.remove("terracotta")
@@ -513,7 +516,7 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> Parsed
         # "pool table", "power plant": WordNet names another object ending in a category word.
         cat, span = None, None
     q.category = cat
-    known = (set(_FILLER) | set(LEXICON) | set(ALIASES) | set(_SHAPES) | set(_SIZE_WORDS) | set(_SUPERLATIVE)
+    known = (set(_FILLER) | set(LEXICON) | set(ALIASES) | set(_SHAPES) | _SIZE_TOKENS | set(_SUPERLATIVE)
              | _MATERIALS | _COMMON_ADJECTIVES | {w for c in q.colors for w in c.split()}
              | {w for w in words if re.fullmatch(r"[a-z]+-colou?red", w)})
     if cat is not None and span is not None:
@@ -541,6 +544,19 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> Parsed
     noun = q.category if q.category is not None else " ".join(rest[-2:]) if rest else ""
     q.target_phrase = " ".join([*desc, noun]).strip() or norm
     return q
+
+
+def _size_word(words: list[str]) -> str | None:
+    """"large" / "small" from the first size word ("king size" and "king-size" alike); a size word
+    right after "a" / "an" that ends the sentence is a noun ("I need a wee", "move a little")."""
+    for i in range(len(words)):
+        for n in (2, 1):
+            gram = " ".join(words[i:i + n])
+            if i + n <= len(words) and gram in _SIZE_WORDS:
+                if i + n == len(words) and i > 0 and words[i - 1] in ("a", "an"):
+                    continue
+                return _SIZE_WORDS[gram]
+    return None
 
 
 def _other_object(words: list[str], span: tuple[int, int] | None) -> str | None:
