@@ -10,6 +10,10 @@ facade does not cover.
     nav = CapNav.open("apt0.capnav")
     answer = nav.ask("the pink armchair", robot=(1.0, 2.0))
     plan = nav.plan((1.0, 2.0, 0.0), answer)
+
+Planning goes as in ``capnav navigate`` (``capnav.planning.on_map``): on the mapped occupancy with
+the unknown cells near the camera path counted as free, and from the map's last camera pose when
+no start is given.
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ from numpy.typing import NDArray
 
 from capnav.core.errors import InputError, NotFoundError
 from capnav.core.frame import Frame
+from capnav.core.grid import OccupancyGrid
 from capnav.language.describe import DescribeReport
 from capnav.language.embedder import TextEmbedder
 from capnav.mapping.cmap import CapNavMap
@@ -76,9 +81,13 @@ class ObjectRecord:
 
 @dataclass(frozen=True)
 class Answer:
-    """What ``ask`` returns: the chosen object (None when nothing fits), its similarity, the reason
-    in words, the runners-up with their similarities and, when the robot's position was given, the
-    goal pose to stop at (``goal``; its own ``reason`` says how it was chosen)."""
+    """What ``ask`` returns: the chosen object (None when nothing fits); ``score``, its caption's
+    cosine similarity to the instruction (eq. 16; 0 when nothing fits); the reason in words; the
+    runners-up in decision order with their final scores (the verification value where the
+    candidate was judged, 0 when it was rejected, else the caption similarity: not one scale);
+    and, when the robot's position was given, the goal pose to stop at (``goal``; its own
+    ``reason`` says how it was chosen). ``to_dict`` keeps these names: ``score`` and
+    ``runners_up[i].score``."""
 
     instruction: str
     object: ObjectRecord | None
@@ -170,6 +179,7 @@ class CapNav:
         self._embedder: TextEmbedder | None = embedder if isinstance(embedder, TextEmbedder) else None
         self._retriever: Retriever | None = None
         self._costmap: Costmap | None = None
+        self._grid: tuple[OccupancyGrid, list[str]] | None = None
         self._frames: Any = None  # the frames a map was built from (for captioning views)
 
     # -- opening, building, saving ----------------------------------------------------------------
@@ -289,12 +299,32 @@ class CapNav:
         return self._retriever
 
     @property
+    def occupancy(self) -> OccupancyGrid:
+        """The grid goals and paths are planned on: the map's occupancy with the unknown cells
+        within ``PATH_FREE_RADIUS`` of the camera path counted as free (``planning_grid``)."""
+        if self._grid is None:
+            from capnav.planning.on_map import planning_grid
+
+            self._grid = planning_grid(self.map)
+        return self._grid[0]
+
+    @property
     def costmap(self) -> Costmap:
         if self._costmap is None:
             from capnav.planning.costmap import build_costmap
 
-            self._costmap = build_costmap(self.map.occupancy, self.planner_config)
+            self._costmap = build_costmap(self.occupancy, self.planner_config)
         return self._costmap
+
+    def start_pose(self) -> tuple[tuple[float, float, float], str]:
+        """The default start, as ``capnav navigate`` takes it: the map's last camera pose (x, y, yaw)
+        and where it came from; ``InputError`` for a map that records no camera path."""
+        from capnav.planning.on_map import camera_start
+
+        if self.map.trajectory is None or not len(self.map.trajectory):
+            raise InputError("this map records no camera path (built before CapNav stored it, or from no frame): "
+                             "give a start x, y[, yaw]")
+        return camera_start(self.map.trajectory)
 
     def ask(self, instruction: str, robot: Sequence[float] | None = None, k: int | None = None) -> Answer:
         """Retrieve the object ``instruction`` describes. ``robot`` (x, y[, yaw]) in metres gives
@@ -319,16 +349,19 @@ class CapNav:
         from capnav.planning.goal import select_goal
 
         try:
-            return select_goal(self.map.occupancy, obj.footprint, xy, self.planner_config, self.costmap), ""
+            return select_goal(self.occupancy, obj.footprint, xy, self.planner_config, self.costmap), ""
         except (NotFoundError, InputError) as e:
             return None, f"no goal pose: {e}"
 
-    def plan(self, start: Sequence[float], target: Answer | ObjectRecord | int) -> Plan:
-        """A* from ``start`` (x, y[, yaw]) to a goal pose within reach of the target object (an
-        ``Answer``, an ``ObjectRecord`` or an object id)."""
+    def plan(self, start: Sequence[float] | None, target: Answer | ObjectRecord | int) -> Plan:
+        """A* from ``start`` (x, y[, yaw]; None: the map's last camera pose, see ``start_pose``) to a
+        goal pose within reach of the target object (an ``Answer``, an ``ObjectRecord`` or an
+        object id)."""
         from capnav.planning.goal import select_goal
         from capnav.planning.path import plan_path
 
+        if start is None:
+            start = self.start_pose()[0]
         xy = _xy(start, "start")
         assert xy is not None
         s = np.asarray(start, dtype=np.float64).ravel()
@@ -343,8 +376,8 @@ class CapNav:
         try:
             goal = target.goal if isinstance(target, Answer) and target.robot == xy else None
             if goal is None:  # an answer asked from this start already holds its goal: one search less
-                goal = select_goal(self.map.occupancy, obj.footprint, xy, self.planner_config, self.costmap)
-            path = plan_path(self.map.occupancy, xy, goal.xy, self.planner_config, self.costmap)
+                goal = select_goal(self.occupancy, obj.footprint, xy, self.planner_config, self.costmap)
+            path = plan_path(self.occupancy, xy, goal.xy, self.planner_config, self.costmap)
         except NotFoundError as e:
             return Plan(False, np.array([[*xy, yaw0]]), 0.0, str(e), None, oid)
         poses = _headings(path.waypoints, yaw0, goal.yaw)

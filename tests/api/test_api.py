@@ -10,7 +10,9 @@ import pytest
 
 from capnav.api import Answer, CapNav, ObjectRecord, Plan
 from capnav.core.errors import InputError
-from language.synth import described_living_map, grid_with_wall, living_scene, make_map
+from capnav.core.grid import FREE, OCCUPIED, UNKNOWN
+from capnav.mapping.cmap import CapNavMap
+from language.synth import described_living_map, grid_with_wall, living_scene, make_map, walked_through_the_door
 
 
 @pytest.fixture(scope="module")
@@ -100,3 +102,36 @@ def test_uncaptioned_map_says_what_to_do(tmp_path: Path) -> None:
         nav.ask("the red sofa")
     rep = nav.caption()  # no frames: keeps (no) views, captions from what the map observed
     assert rep.objects == 7 and nav.ask("the red sofa").object.id == 1
+
+
+def test_plans_like_navigate_from_the_camera_path(map_file: Path) -> None:
+    """``plan`` starts where ``capnav navigate`` does (the last camera pose) and plans on the same
+    grid (unknown cells near the camera path free): with unknown space blocked, the door the camera
+    walked through is the only way to the sofa."""
+    from capnav.planning.config import PlannerConfig
+    from capnav.planning.on_map import camera_yaw, navigate_on_map
+
+    cmap = walked_through_the_door(map_file)
+    cfg = PlannerConfig(unknown_cost=None)
+    nav = CapNav(cmap, planner=cfg)
+    (x, y, yaw), source = nav.start_pose()
+    last = cmap.trajectory.poses[-1]  # type: ignore[union-attr]
+    assert (x, y, yaw) == pytest.approx((6.0, 3.0, camera_yaw(last))) and source == "the last camera pose (frame 30)"
+    assert (nav.occupancy.cells[cmap.occupancy.cells == UNKNOWN] == FREE).any()  # the door, crossed
+    np.testing.assert_array_equal(nav.occupancy.cells == OCCUPIED, cmap.occupancy.cells == OCCUPIED)
+    plan = nav.plan(None, 1)
+    assert plan.success, plan.reason
+    assert plan.poses[0] == pytest.approx([6.0, 3.0, yaw])
+    ref = navigate_on_map(cmap, nav.retriever, "the red sofa", config=cfg)
+    assert ref.ok and ref.query.chosen is not None and ref.query.chosen.id == 1 and ref.path is not None
+    np.testing.assert_array_equal(nav.occupancy.cells, ref.occupancy.cells)
+    np.testing.assert_allclose(plan.poses[:, :2], ref.path.waypoints)
+    assert plan.length_m == pytest.approx(ref.path.length_m)
+    ans = nav.ask("the red sofa", robot=(x, y))
+    assert ans.goal is not None and ans.goal.xy == pytest.approx(ref.goal.xy)  # type: ignore[union-attr]
+    # the mapped grid alone has no way through: the same start is cut off from the sofa
+    blind = CapNav(CapNavMap(cmap.objects, cmap.voxels, cmap.occupancy, cmap.meta, cmap.caches, trajectory=None),
+                   planner=cfg)
+    assert not blind.plan((6.0, 3.0), 1).success
+    with pytest.raises(InputError, match="records no camera path"):
+        blind.plan(None, 1)

@@ -8,8 +8,8 @@ import numpy as np
 
 from capnav.core.frame import Frame
 from capnav.core.geometry import Intrinsics, look_at_pose
-from capnav.core.grid import FREE, OCCUPIED, GridSpec, OccupancyGrid
-from capnav.mapping.cmap import CapNavMap
+from capnav.core.grid import FREE, OCCUPIED, UNKNOWN, GridSpec, OccupancyGrid
+from capnav.mapping.cmap import CameraTrajectory, CapNavMap
 from capnav.mapping.objects import MapObject, Observation
 from capnav.mapping.voxel_map import VoxelMap
 
@@ -117,3 +117,21 @@ def described_living_map(folder: Path) -> Path:
     path = folder / "living.capnav"
     CapNav(cmap).save(path)
     return path
+
+
+def walked_through_the_door(map_file: Path) -> CapNavMap:
+    """The living map with its door's floor unknown (depth never saw it) and a camera path from the
+    left room through the door to (6, 3) on the right: the floor the camera crossed is free."""
+    from capnav.io.mapfile import load_map
+
+    cmap = load_map(map_file)
+    spec = cmap.occupancy.spec
+    rr, cc = np.mgrid[0:spec.rows, 0:spec.cols]
+    xy = spec.to_world(np.stack([rr, cc], axis=-1))
+    door = (np.abs(xy[..., 0] - 3.8) < 0.15) & (xy[..., 1] > 2.4) & (xy[..., 1] < 3.6)
+    cmap.occupancy.cells[door & (cmap.occupancy.cells == FREE)] = UNKNOWN
+    xs = np.linspace(1.0, 6.0, 11)
+    cmap.trajectory = CameraTrajectory(np.arange(11) * 3, np.stack([look_at_pose(np.array([x, 3.0, 1.2]), 0.0, 0.3)
+                                                                   for x in xs]))
+    return cmap
+

@@ -98,7 +98,6 @@ def test_bad_bodies(client: TestClient) -> None:
     r = client.post("/api/query", json={"text": "x" * 20_000})
     assert r.status_code == 413 and "over 16384 bytes" in r.json()["error"]
     assert client.post("/api/plan", json={"start": [6, 3], "object": 99}).status_code == 404
-    assert client.post("/api/plan", json={"object": 1}).status_code == 422
     assert client.get("/api/query").status_code == 405
 
 
@@ -127,3 +126,22 @@ def test_token_bucket_refills() -> None:
     assert rl.take("b") == 0  # per client
     t[0] = 0.5
     assert rl.take("a") == 0 and rl.take("a") > 0
+
+
+def test_starts_like_navigate_on_a_map_with_a_camera_path(served_map: Path) -> None:
+    """The page's default robot and a plan without a start are the map's last camera pose, and
+    plans go through unknown floor the camera walked (the same grid as ``capnav navigate``)."""
+    from capnav.api import CapNav
+    from capnav.planning.config import PlannerConfig
+    from language.synth import walked_through_the_door
+
+    nav = CapNav(walked_through_the_door(served_map), planner=PlannerConfig(unknown_cost=None))
+    with TestClient(create_app(nav, ServeConfig(warm_up=False))) as c:
+        assert c.get("/api/map").json()["default_robot"] == [6.0, 3.0]
+        p = c.post("/api/plan", json={"object": 1}).json()
+        assert p["success"] and p["poses"][0][:2] == [6.0, 3.0] and p["target"] == 1
+        d = c.post("/api/query", json={"text": "the red sofa", "robot": [6.0, 3.0]}).json()
+        assert d["object"]["id"] == 1 and d["plan"]["success"] and d["plan"]["poses"][-1] == p["poses"][-1]
+    with TestClient(create_app(served_map, ServeConfig(warm_up=False))) as c:  # no camera path: a start is needed
+        r = c.post("/api/plan", json={"object": 1})
+        assert r.status_code == 422 and "records no camera path" in r.json()["error"]

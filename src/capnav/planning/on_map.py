@@ -76,6 +76,17 @@ def free_along_path(occ: OccupancyGrid, xy: NDArray[np.floating], radius: float 
     return OccupancyGrid(s, cells), int(change.sum())
 
 
+def planning_grid(cmap: CapNavMap, radius: float = PATH_FREE_RADIUS) -> tuple[OccupancyGrid, list[str]]:
+    """The grid to plan on for a map: its occupancy with the unknown cells within ``radius`` of the
+    camera path counted as free, and a note saying how many (none for a map with no camera path).
+    ``capnav navigate``, the library API and the map server all plan on this grid."""
+    occ, notes = cmap.occupancy, []
+    if cmap.trajectory is not None and len(cmap.trajectory):
+        occ, n = free_along_path(occ, cmap.trajectory.poses[:, :2, 3], radius)
+        notes.append(f"{n} unknown cells within {radius:.2f} m of the camera path counted as free")
+    return occ, notes
+
+
 @dataclass
 class MapNavigation:
     """An instruction answered on a map: the object chosen, the goal pose (x, y, yaw facing the
@@ -120,10 +131,7 @@ def navigate_on_map(cmap: CapNavMap, retriever: Retriever, instruction: str,
     source = "--start"
     if start is None:
         start, source = camera_start(cmap.trajectory)
-    occ, notes = cmap.occupancy, []
-    if cmap.trajectory is not None and len(cmap.trajectory):
-        occ, n = free_along_path(occ, cmap.trajectory.poses[:, :2, 3], path_free_radius)
-        notes.append(f"{n} unknown cells within {path_free_radius:.2f} m of the camera path counted as free")
+    occ, notes = planning_grid(cmap, path_free_radius)
     cm = build_costmap(occ, cfg)
     xy = (start[0], start[1])
     locate_start(cm, xy, cfg)  # a start off the map or in an obstacle is the user's error: raise now

@@ -59,9 +59,13 @@ def _error(status: int, why: str) -> JSONResponse:
 
 
 def default_robot(nav: CapNav) -> tuple[float, float] | None:
-    """A start for the page until the user clicks one: the free cell farthest from any non-free
-    cell (an open spot in the middle of a room)."""
-    occ = nav.map.occupancy
+    """A start for the page until the user clicks one: the map's last camera pose, as ``capnav
+    navigate`` starts (``CapNav.start_pose``); for a map with no camera path, the free cell farthest
+    from any non-free cell (an open spot in the middle of a room)."""
+    if nav.map.trajectory is not None and len(nav.map.trajectory):
+        (x, y, _), _ = nav.start_pose()
+        return (round(x, 3), round(y, 3))
+    occ = nav.occupancy
     free = occ.cells == FREE
     if not free.any():
         return None
@@ -186,9 +190,7 @@ def create_app(map_or_nav: CapNav | CapNavMap | str | Path, config: ServeConfig 
         if not isinstance(oid, int) or isinstance(oid, bool):
             return _error(422, "'object' (a map object id, an integer) is required")
         try:
-            start = _robot({"robot": body.get("start")})
-            if start is None:
-                return _error(422, "'start' ([x, y] or [x, y, yaw]) is required")
+            start = _robot({"robot": body.get("start")})  # None: the map's last camera pose
             async with lock:
                 plan = nav.plan(start, oid)
         except NotFoundError as e:
