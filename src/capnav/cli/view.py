@@ -16,13 +16,17 @@ def register(app: typer.Typer) -> None:
                        ] = Path("map.rrd"),
         query: Annotated[list[str] | None, typer.Option(
             "--query", "-q", help="an instruction to answer and show (repeatable)")] = None,
-        robot: Annotated[str | None, typer.Option(help="robot position X,Y (m): plans a path to each answer")
-                         ] = None,
+        robot: Annotated[str | None, typer.Option(
+            help="robot position X,Y (m) to plan a path to each answer from; default: the map's last camera "
+                 "pose, as capnav navigate starts")] = None,
         connect: Annotated[str | None, typer.Option(
             help="send to a running rerun viewer at this gRPC URL instead of writing --out "
                  "(e.g. rerun+http://127.0.0.1:9876/proxy)")] = None,
         max_voxels: Annotated[int, typer.Option(min=1, help="voxels logged at most (a seeded subsample beyond)")
                               ] = 300_000,
+        max_z: Annotated[float | None, typer.Option(
+            help="leave out voxels above this height (m), e.g. 2.0 to drop the ceiling and look in from above")
+                         ] = None,
     ) -> None:
         """Log the voxel map, object boxes with ids and captions, the camera path and answers to rerun."""
         from rich.console import Console
@@ -33,13 +37,17 @@ def register(app: typer.Typer) -> None:
 
         xy = parse_xy(robot)
         nav = CapNav.open(map_path)
+        con = Console(stderr=True)
+        if xy is None and query and nav.map.trajectory is not None and len(nav.map.trajectory):
+            (x, y, _), source = nav.start_pose()
+            xy = (x, y)
+            con.print(f"robot at ({x:.2f}, {y:.2f}): {source}", highlight=False)
         answers = []
         for text in query or []:
             ans = nav.ask(text, robot=xy)
             plan = nav.plan(xy, ans) if xy is not None and ans.goal is not None else None
             answers.append((ans, plan))
-        path = write_rrd(nav.map, out, answers, connect=connect, max_voxels=max_voxels)
-        con = Console(stderr=True)
+        path = write_rrd(nav.map, out, answers, connect=connect, max_voxels=max_voxels, max_z=max_z)
         for ans, plan in answers:
             got = f"object {ans.object.id}: {ans.object.caption}" if ans.object else "not found"
             con.print(f'"{ans.instruction}" -> {got}' + (f"; path {plan.length_m:.2f} m" if plan else ""),

@@ -71,18 +71,24 @@ def camera_path(cmap: CapNavMap) -> tuple[NDArray[np.int64], NDArray[np.float64]
     return np.asarray(traj.frames, dtype=np.int64), np.asarray(traj.poses, dtype=np.float64)
 
 
-def log_map(rec: Any, cmap: CapNavMap, max_voxels: int = 300_000, seed: int = 0) -> None:
-    """Log the map itself (static entities and the camera's timeline) to ``rec``."""
+def log_map(rec: Any, cmap: CapNavMap, max_voxels: int = 300_000, seed: int = 0, max_z: float | None = None) -> None:
+    """Log the map itself (static entities and the camera's timeline) to ``rec``. ``max_z`` leaves
+    out the voxels whose centre is above it (the ceiling hides the rooms from above)."""
     rr = _rerun()
     rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
     vox = cmap.voxels
     if len(vox):
         centres = vox.centers()
         colours = np.clip(np.asarray(vox.colors), 0, 255).astype(np.uint8)
+        if max_z is not None:
+            below = centres[:, 2] <= max_z
+            centres, colours = centres[below], colours[below]
         if len(centres) > max_voxels:  # a seeded subsample keeps huge maps viewable
             keep = np.sort(np.random.default_rng(seed).choice(len(centres), max_voxels, replace=False))
             centres, colours = centres[keep], colours[keep]
-        rec.log("world/map/voxels", rr.Points3D(centres, colors=colours, radii=0.5 * vox.resolution), static=True)
+        if len(centres):
+            rec.log("world/map/voxels", rr.Points3D(centres, colors=colours, radii=0.5 * vox.resolution),
+                    static=True)
     occ = cmap.occupancy
     rc = np.argwhere(occ.cells == OCCUPIED)
     if len(rc):
@@ -130,30 +136,66 @@ def log_answer(rec: Any, cmap: CapNavMap, answer: Answer, n: int = 0, plan: Plan
         rec.log(f"{base}/runners_up", rr.Boxes3D(mins=[o.extent_min for o in ro],
                                                  sizes=[o.extent_max - o.extent_min for o in ro],
                                                  labels=[f"{r.id} ({s:.2f})" for r, s in answer.runners_up],
-                                                 colors=[RUNNER_RGB] * len(ro), radii=0.01), static=True)
+                                                 colors=[RUNNER_RGB] * len(ro), radii=0.01, show_labels=False),
+                static=True)  # their own "id CATEGORY" labels are already on screen; scores show on hover
     if plan is not None and len(plan.poses) > 1:
         pts = np.column_stack([plan.poses[:, :2], np.full(len(plan.poses), 0.05)])
-        rec.log("world/path", rr.LineStrips3D([pts], colors=PATH_RGB, radii=0.03,
+        rec.log("world/path", rr.LineStrips3D([pts], colors=PATH_RGB, radii=0.05,
                                               labels=[f"{plan.length_m:.2f} m"]), static=True)
 
 
+def eye_pose(cmap: CapNavMap) -> tuple[list[float], list[float]]:
+    """Where the 3D view starts: looking down at about 50 degrees from south of the map (-y) onto
+    its centre on the floor, far enough back to see the whole floor plan."""
+    spec = cmap.occupancy.spec
+    lo = np.array([spec.x0, spec.y0], dtype=np.float64)
+    size = np.array([spec.cols, spec.rows], dtype=np.float64) * spec.resolution
+    if len(cmap.voxels):
+        c = cmap.voxels.centers()[:, :2]
+        lo, size = c.min(axis=0), np.ptp(c, axis=0)
+    centre = lo + size / 2
+    span = float(max(size.max(), 1.0))
+    eye = [float(centre[0]), float(lo[1] - 0.45 * size[1]), span]
+    return eye, [float(centre[0]), float(centre[1] + 0.05 * size[1]), 0.0]
+
+
+def map_blueprint(cmap: CapNavMap, answers: Sequence[tuple[Answer, Plan | None]] = ()) -> Any:
+    """The layout the recording opens with: the 3D map from above and, per answer, its reason
+    and the chosen object's captioning view beside it (rerun's own guess puts every caption in a
+    view of its own)."""
+    rr = _rerun()
+    rrb = rr.blueprint
+    eye, target = eye_pose(cmap)
+    space = rrb.Spatial3DView(origin="world", name="map", eye_controls=rrb.EyeControls3D(position=eye,
+                                                                                        look_target=target))
+    side: list[Any] = []
+    for n, (ans, _) in enumerate(answers):
+        side.append(rrb.TextDocumentView(origin=f"world/query/{n}/reason", name=f"answer {n}"))
+        if ans.object is not None and any(v.frame_png for v in cmap.object(ans.object.id).views):
+            side.append(rrb.Spatial2DView(origin=f"views/{ans.object.id}", name=f"view of {ans.object.id}"))
+    root = rrb.Horizontal(space, rrb.Vertical(*side), column_shares=[3, 1]) if side else space
+    return rrb.Blueprint(root, rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
+                         rrb.TimePanel(state="collapsed"))
+
+
 def write_rrd(cmap: CapNavMap, out: str | Path, answers: Sequence[tuple[Answer, Plan | None]] = (),
-              connect: str | None = None, max_voxels: int = 300_000) -> Path | None:
+              connect: str | None = None, max_voxels: int = 300_000, max_z: float | None = None) -> Path | None:
     """Log the map and the answers to ``out`` (an ``.rrd`` file), or to the viewer at ``connect``
-    (a rerun gRPC URL) when given. Returns the file written."""
+    (a rerun gRPC URL) when given; ``max_z`` as in ``log_map``. Returns the file written."""
     rr = _rerun()
     rec = rr.RecordingStream("capnav", recording_id=str(cmap.meta.get("eval_key") or "capnav-map"))
     path = None
+    layout = map_blueprint(cmap, answers)
     if connect:
-        rec.connect_grpc(connect)
+        rec.connect_grpc(connect, default_blueprint=layout)
     else:
         path = Path(out)
         if path.suffix != ".rrd":
             raise InputError(f"the output must be an .rrd file, got {path}")
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_name(path.name + ".part")
-        rec.save(tmp)
-    log_map(rec, cmap, max_voxels=max_voxels)
+        rec.save(tmp, default_blueprint=layout)
+    log_map(rec, cmap, max_voxels=max_voxels, max_z=max_z)
     for n, (ans, plan) in enumerate(answers):
         log_answer(rec, cmap, ans, n, plan)
     rec.flush()
