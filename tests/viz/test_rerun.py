@@ -172,6 +172,10 @@ def test_rerun_viewer_opens_and_draws_it(captioned: Path, tmp_path: Path) -> Non
             pytest.skip(f"no graphics adapter for rerun's viewer: {e}")
         raise
     assert set(shot.views) == {("map", "3D"), ("answer 0", "TextDocument")} and shot.frame == 6
+    assert len(shot.viewer_pids) >= 2  # the launcher and the viewer binary it started
+    for pid in shot.viewer_pids:  # both ended
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)
     img = np.asarray(Image.open(io.BytesIO(shot.png)).convert("RGB")).astype(int)
     assert img.shape[0] > 200 and img.shape[1] > 300
 

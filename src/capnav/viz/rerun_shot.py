@@ -10,8 +10,10 @@ GPU. It is started on a free loopback port, opens the recording with the layout 
 from __future__ import annotations
 
 import contextlib
+import os
 import re
 import shutil
+import signal
 import socket
 import subprocess
 import sys
@@ -35,6 +37,17 @@ class ViewerShot:
     png: bytes
     views: tuple[tuple[str, str], ...]
     frame: int | None  # where the ``frame`` time cursor stood, when the recording has that timeline
+    viewer_pids: tuple[int, ...]  # the viewer's processes (its group, on Linux), all ended before this returns
+
+
+@dataclass(frozen=True)
+class HeadlessViewer:
+    """A running headless viewer: its control client, its process group id and the processes in
+    that group once it answered (from /proc; empty elsewhere)."""
+
+    client: Any
+    pid: int
+    members: tuple[int, ...]
 
 
 def rerun_executable() -> Path:
@@ -53,10 +66,11 @@ def _free_port() -> int:
 
 
 @contextlib.contextmanager
-def headless_viewer(size: tuple[int, int] = (1280, 800), timeout: float = 60.0) -> Iterator[Any]:
-    """A ``rerun --headless`` viewer of ``size`` (points) on a free loopback port; yields a
-    connected ``ViewerClient`` and stops the viewer on exit. A viewer that dies at start (no
-    graphics adapter) raises ``CapNavError`` with the last lines it printed."""
+def headless_viewer(size: tuple[int, int] = (1280, 800), timeout: float = 60.0) -> Iterator[HeadlessViewer]:
+    """A ``rerun --headless`` viewer of ``size`` (points) on a free loopback port with a connected
+    ``ViewerClient``, stopped on exit. It runs in a process group of its own, ended whole (the
+    ``rerun`` entry point is a Python launcher that starts the viewer binary as its child). A viewer
+    that dies (no graphics adapter) raises ``CapNavError`` with the lines it printed about it."""
     rr = _rerun()
     from rerun.experimental import ViewerClient
 
@@ -64,7 +78,7 @@ def headless_viewer(size: tuple[int, int] = (1280, 800), timeout: float = 60.0) 
     cmd = [str(rerun_executable()), "--headless", "--bind", "127.0.0.1", "--port", str(port),
            "--window-size", f"{size[0]}x{size[1]}", "--hide-welcome-screen"]
     with tempfile.TemporaryFile() as log:
-        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT)
+        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
 
         def died() -> str:  # the panic or error lines (a backtrace follows them), else the last lines
             log.seek(0)
@@ -89,19 +103,42 @@ def headless_viewer(size: tuple[int, int] = (1280, 800), timeout: float = 60.0) 
                                           f"{timeout:.0f} s") from None
                     time.sleep(0.3)
             try:
-                yield client
+                yield HeadlessViewer(client, proc.pid, _group_members(proc.pid))
             except Exception as e:
                 time.sleep(0.5)
                 if proc.poll() is not None and not isinstance(e, CapNavError):  # it died under us
                     raise CapNavError(died()) from e
                 raise
         finally:
-            proc.terminate()
+            _end_group(proc)
+
+
+def _group_members(pgid: int) -> tuple[int, ...]:
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        with contextlib.suppress(OSError, ValueError, IndexError):
+            fields = stat.read_text().rsplit(")", 1)[1].split()  # after "pid (comm)": state ppid pgrp ...
+            if int(fields[2]) == pgid:
+                out.append(int(stat.parent.name))
+    return tuple(sorted(out))
+
+
+def _end_group(proc: subprocess.Popen[bytes]) -> None:
+    """SIGTERM to the viewer's process group, SIGKILL after 10 s; the launcher is reaped."""
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, sig)
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            continue
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline:  # the binary may outlive its launcher by a moment
             try:
-                proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+                os.killpg(proc.pid, 0)
+            except ProcessLookupError:
+                return
+            time.sleep(0.1)
 
 
 def screenshot_rrd(rrd: str | Path, *, size: tuple[int, int] = (1280, 800), frame: int | None = None,
@@ -112,7 +149,8 @@ def screenshot_rrd(rrd: str | Path, *, size: tuple[int, int] = (1280, 800), fram
     path = Path(rrd).resolve()
     if not path.is_file():
         raise InputError(f"no recording at {path}")
-    with headless_viewer(size, timeout) as client:
+    with headless_viewer(size, timeout) as viewer:
+        client = viewer.client
         client.open(str(path))
         deadline = time.monotonic() + timeout
         while True:
@@ -140,4 +178,4 @@ def screenshot_rrd(rrd: str | Path, *, size: tuple[int, int] = (1280, 800), fram
             time.sleep(settle)
         vid = next((v.view_id for v in views if v.name == view), None)
         png = client.take_screenshot(vid)
-    return ViewerShot(png, tuple((v.name, v.view_class) for v in views), cursor)
+    return ViewerShot(png, tuple((v.name, v.view_class) for v in views), cursor, viewer.members)
