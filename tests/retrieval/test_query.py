@@ -261,3 +261,21 @@ def test_a_multi_word_typo_needs_words_that_are_no_english_words():
 ])
 def test_size_words(text, size):
     assert parse_instruction(text).size_word == size
+
+
+@pytest.mark.parametrize(("text", "landmark"), [
+    ("somewhere to set my drink down while I watch the tv", "tv"),
+    ("where can I leave my glasses when I am in bed", "bed"),
+])
+def test_a_purpose_with_a_clause_of_its_own_targets_the_object_not_the_landmark(text, landmark, emb):
+    q = parse_instruction(text, emb)
+    assert q.purpose and q.category not in (None, landmark), q.to_dict()
+    assert (q.relation, q.anchor_category) == ("in the room with", landmark)
+
+
+def test_a_purpose_brings_the_lexicon_s_relatives_of_what_serves_it(emb):
+    # a place to sit: a stool is a chair's sibling in WordNet, so it stays a candidate (weighted
+    # below the chair) and a room can choose it
+    q = parse_instruction("where could I sit for a minute in the office", emb)
+    assert {"chair", "stool"} <= {q.category, *q.category_alternatives}, q.to_dict()
+    assert q.category_alternatives["stool"] < q.category_alternatives.get("chair", 1.0)

@@ -361,6 +361,28 @@ def _room_with(q: ParsedQuery, head: str) -> str:
     return " ".join([head[: m.start()], *found[2]]).strip()
 
 
+#: A clause of its own inside a purpose request: "... while I watch telly", "... when we eat".
+_CONTEXT_CLAUSE = re.compile(r"\b(?:while|whilst|when|as|and)\s+(?:i|we|you)\s+(?:(?:can|could|am|are|'m)\s+)?"
+                             r"(?P<ctx>.+)$")
+
+
+def _purpose_context(q: ParsedQuery, head: str) -> str:
+    """A purpose request with a clause of its own that names an object ("somewhere to put my
+    coffee down while I watch telly"): the object is the setting, not the target; the target is
+    looked for in the room with it (``ROOM_WITH``). Returns ``head`` without the clause."""
+    if find_activity(head) is None:
+        return head
+    m = _CONTEXT_CLAUSE.search(head)
+    if m is None or find_activity(head[: m.start()]) is None:
+        return head
+    words = m.group("ctx").split()
+    cat, span, _ = _find_category(words)
+    if cat is None or span is None:
+        return head
+    q.relation, q.anchor_category, q.anchor_phrase = ROOM_WITH, cat, " ".join(words[span[0]:span[1]])
+    return head[: m.start()].strip()
+
+
 def _between(q: ParsedQuery, head: str) -> str:
     """"the table between the green sofa and the purple armchair": two landmarks, each with its
     own words. Returns ``head`` without them."""
@@ -449,6 +471,8 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> Parsed
     norm = " ".join(_fix_keyword_typos(norm.replace("'s", "").split()))
     q = ParsedQuery(text=t)
     head = _negations(q, norm)
+    # "somewhere to put my coffee down while I watch telly": the telly is where, not what.
+    head = _purpose_context(q, head)
     # "the bed in the room with the pink dresser", "the wardrobe in the bedroom with the yellow bed".
     head = _room_with(q, head)
     # Room: "in the kitchen", "in the living room".
@@ -537,6 +561,12 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> Parsed
             if embedder is not None:
                 best, alts = purpose_categories(match_purpose(activity, embedder))
                 if best is not None:
+                    # The lexicon's relatives of each category that serves (a stool beside a chair),
+                    # weighted below it: a room or a landmark can then choose among them.
+                    for c, w in [(best, 1.0), *alts.items()]:
+                        for other, w2 in _LEX.category_alternatives(c).items():
+                            if other != best:
+                                alts[other] = max(alts.get(other, 0.0), round(w * w2, 3))
                     q.category, q.category_alternatives, q.unknown_words = best, alts, []
     else:
         q.unknown_words = rest
