@@ -16,6 +16,7 @@ stored with the map. ``feature_dim=None`` keeps full features.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -23,7 +24,13 @@ from numpy.typing import NDArray
 from capnav.core.errors import InputError
 from capnav.core.geometry import Intrinsics
 from capnav.core.grid import GridSpec
-from capnav.mapping import _kernels as K_
+
+if TYPE_CHECKING:
+    from capnav.mapping import _kernels as K_
+else:  # numba loads when a voxel is first hashed or fused, not when a map without voxels is read
+    from capnav.core.lazy import lazy_module
+
+    K_ = lazy_module("capnav.mapping._kernels")
 
 
 @dataclass(frozen=True)
@@ -95,7 +102,8 @@ class VoxelMap:
         self.dim = int(feature_dim)
         self.text_space = text_space
         self._n = 0
-        self._ck, self._cs = K_.new_cache()  # recent key -> slot; slots never move, so never stale
+        self._ck: NDArray[np.int64] | None = None  # recent key -> slot (built on first fusion);
+        self._cs: NDArray[np.int32] | None = None  # slots never move, so it is never stale
         self._alloc(max(capacity, 16))
 
     # ---- storage -------------------------------------------------------------------------
@@ -108,7 +116,15 @@ class VoxelMap:
 
     def _rehash(self, table_cap: int) -> None:
         self._shift = np.uint64(64 - int(np.log2(table_cap)))
-        self._tk, self._tv = K_.rehash(self._keys, self._n, table_cap, self._shift)
+        if self._n == 0:  # what the kernel returns for no keys, without loading numba
+            self._tk, self._tv = np.full(table_cap, -1, dtype=np.int64), np.zeros(table_cap, dtype=np.int32)
+        else:
+            self._tk, self._tv = K_.rehash(self._keys, self._n, table_cap, self._shift)
+
+    def _recent(self) -> tuple[NDArray[np.int64], NDArray[np.int32]]:
+        if self._ck is None or self._cs is None:
+            self._ck, self._cs = K_.new_cache()
+        return self._ck, self._cs
 
     def _reserve(self, extra: int) -> None:
         need = self._n + extra
@@ -137,7 +153,7 @@ class VoxelMap:
     @property
     def coords(self) -> NDArray[np.int32]:
         """(N, 3) eq. 4 indices (i, j, k) of the observed voxels."""
-        return K_.unpack_keys(self.keys)
+        return K_.unpack_keys(self.keys) if self._n else np.zeros((0, 3), dtype=np.int32)
 
     @property
     def colors(self) -> NDArray[np.float32]:
@@ -203,7 +219,7 @@ class VoxelMap:
         while done < n:  # grow with the voxels actually seen (a point is rarely a new voxel)
             self._reserve(min(n - done, max(self._n // 2, 1 << 14)))
             limit = min(self._keys.shape[0], self._tk.shape[0] // 2)
-            self._n, done = K_.fuse_points(self._ck, self._cs, self._tk, self._tv, self._shift, self._keys,
+            self._n, done = K_.fuse_points(*self._recent(), self._tk, self._tv, self._shift, self._keys,
                                            self._w, self._c, self._f, self._n, p, self.origin, self.resolution,
                                            a, rgb, fi, phi, done, limit)
 
@@ -225,7 +241,7 @@ class VoxelMap:
             raise InputError(f"rgb {rgb.shape} / intrinsics {K.height}x{K.width} do not match depth {depth.shape}")
         self._reserve(len(range(0, h, stride)) * len(range(0, w, stride)))
         intr = np.array([K.fx, K.fy, K.cx, K.cy], dtype=np.float64)
-        self._n = K_.fuse_image(self._ck, self._cs, self._tk, self._tv, self._shift, self._keys, self._w, self._c,
+        self._n = K_.fuse_image(*self._recent(), self._tk, self._tv, self._shift, self._keys, self._w, self._c,
                                 self._f, self._n,
                                 depth, np.ascontiguousarray(rgb, dtype=np.uint8), intr,
                                 np.ascontiguousarray(T_wc, dtype=np.float64), self.origin, self.resolution,
@@ -266,7 +282,7 @@ class VoxelMap:
         dim = int(np.asarray(features).shape[1]) if np.asarray(features).ndim == 2 else 0
         vm = cls(resolution, tuple(np.asarray(origin, dtype=np.float64).tolist()), dim, projection,  # type: ignore[arg-type]
                  text_space, capacity=max(n, 16))
-        keys = K_.pack_keys(np.asarray(coords))
+        keys = K_.pack_keys(np.asarray(coords)) if n else np.zeros(0, dtype=np.int64)
         srt = np.sort(keys)  # 40x faster than np.unique's hash path on 200k keys
         if n and bool((srt[1:] == srt[:-1]).any()):
             raise InputError("voxel coords contain duplicates")
