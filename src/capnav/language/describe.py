@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from capnav.core.progress import track
+from capnav.language import context, purpose
 from capnav.language.captioner import Captioner
 from capnav.language.context import ContextConfig, SceneContext
 from capnav.language.embedder import TextEmbedder
@@ -52,7 +53,8 @@ def describe_map(cmap: CapNavMap, reader: FrameReader | None, captioner: Caption
                 o.views = chosen.get(o.id, [])
             rep.views_selected = len(todo)
     t1 = time.perf_counter()
-    scene = SceneContext(cmap.objects, cmap.occupancy, context_config or ContextConfig())
+    scene = SceneContext(cmap.objects, cmap.occupancy, context_config or ContextConfig(),
+                         store=cmap.caches.setdefault(context.CACHE_KEY, {}))
     cache = cmap.caches.setdefault("captions", {})
     for obj in track(cmap.objects, f"captioning ({captioner.model_id})", enabled=progress):
         key = captioner.cache_key(obj, scene)
@@ -82,6 +84,8 @@ def describe_map(cmap: CapNavMap, reader: FrameReader | None, captioner: Caption
         for o, v in zip(cmap.objects, vecs, strict=True):
             o.embedding = v.copy()
             o.embedding_model = embedder.model_id
+    # Requests by purpose compare to every category's glosses: embedded once here, not per query.
+    cmap.caches[purpose.CACHE_KEY] = purpose.gloss_index(embedder).to_store()
     t3 = time.perf_counter()
     rep.seconds = {"views": t1 - t0, "captions": t2 - t1, "embeddings": t3 - t2}
     cmap.meta["language"] = {"captioner": captioner.model_id, "embedder": embedder.model_id,

@@ -5,12 +5,21 @@ text embedder, to what WordNet says each category is for (the lexicon's glosses:
 place to sleep", a washbasin is "where you can wash your hands and face"), so no hand table maps
 activities to objects. The best category becomes the target; close runners-up become weighted
 alternatives (a place to sit: chair, then armchair, sofa, stool).
+
+Embedding the ~100 glosses takes about 1 s, so ``describe_map`` stores them in the map
+(``cmap.caches["glosses"]``: the vectors with the embedder's ``model_id`` and a digest of the gloss
+texts) and the retriever hands them to ``use_stored_glosses``. They are used only when the query
+embedder's ``model_id`` and the current lexicon's texts give the same digest; otherwise (another
+embedder, a rebuilt lexicon, a map captioned before they were stored) they are computed as before.
 """
 
 from __future__ import annotations
 
+import base64
+import hashlib
 import re
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -54,10 +63,16 @@ def find_activity(text: str) -> str | None:
     return None
 
 
-class GlossIndex:
-    """Gloss embeddings of every category for one embedder (built on first use, then reused)."""
+#: ``CapNavMap.caches`` key of the stored gloss embeddings.
+CACHE_KEY = "glosses"
 
-    def __init__(self, embedder: TextEmbedder, lexicon: Lexicon | None = None, max_glosses: int = 6) -> None:
+
+class GlossIndex:
+    """Gloss embeddings of every category for one embedder (built on first use, then reused);
+    ``stored`` (``to_store``'s output) replaces embedding them when its digest matches."""
+
+    def __init__(self, embedder: TextEmbedder, lexicon: Lexicon | None = None, max_glosses: int = 6,
+                 stored: dict[str, Any] | None = None) -> None:
         lex = lexicon or load_lexicon()
         self.embedder = embedder
         self.cats: list[str] = []
@@ -68,7 +83,18 @@ class GlossIndex:
                 self.cats.append(cat)
                 texts.append(f"{names}: {g}")
         self.cats_arr = np.array(self.cats, dtype=object)
-        self.E: NDArray[np.float32] = embedder.embed(texts) if texts else np.zeros((0, embedder.dim), np.float32)
+        h = hashlib.sha256(f"{embedder.model_id}\n{embedder.dim}\n".encode())
+        h.update("\n".join(texts).encode())
+        self.digest = h.hexdigest()
+        E = _decode(stored, self.digest, (len(texts), embedder.dim)) if stored else None
+        if E is None:
+            E = embedder.embed(texts) if texts else np.zeros((0, embedder.dim), np.float32)
+        self.E: NDArray[np.float32] = E
+
+    def to_store(self) -> dict[str, Any]:
+        """JSON-able: model, digest, shape and the float32 vectors (little-endian, base64)."""
+        return {"model": self.embedder.model_id, "digest": self.digest, "shape": list(self.E.shape),
+                "float32_le": base64.b64encode(np.ascontiguousarray(self.E, dtype="<f4").tobytes()).decode("ascii")}
 
     def scores(self, activity: str) -> dict[str, float]:
         q = self.embedder.embed([f"a place where you can {activity}"])[0]
@@ -79,14 +105,37 @@ class GlossIndex:
         return dict(sorted(best.items(), key=lambda kv: -kv[1]))
 
 
+def _decode(stored: dict[str, Any], digest: str, shape: tuple[int, int]) -> NDArray[np.float32] | None:
+    """The stored vectors when they are the ones ``digest`` names, else None."""
+    try:
+        if stored.get("digest") != digest or tuple(stored.get("shape", ())) != shape:
+            return None
+        E = np.frombuffer(base64.b64decode(stored["float32_le"], validate=True), dtype="<f4")
+        return E.astype(np.float32).reshape(shape) if E.size == shape[0] * shape[1] else None
+    except (KeyError, TypeError, ValueError, AttributeError):
+        return None
+
+
 _INDEXES: dict[str, GlossIndex] = {}
+_STORED: dict[str, dict[str, Any]] = {}
+
+
+def _key(embedder: TextEmbedder) -> str:
+    return f"{embedder.model_id}@{id(embedder)}"
+
+
+def use_stored_glosses(embedder: TextEmbedder, stored: dict[str, Any] | None) -> None:
+    """Offer a map's stored gloss embeddings (``caches["glosses"]``) to ``embedder``'s index, built
+    on the first request by purpose; ignored if the index exists or they do not match."""
+    if stored and _key(embedder) not in _INDEXES:
+        _STORED[_key(embedder)] = stored
 
 
 def gloss_index(embedder: TextEmbedder) -> GlossIndex:
     """One gloss index per embedding model and process."""
-    key = f"{embedder.model_id}@{id(embedder)}"
+    key = _key(embedder)
     if key not in _INDEXES:
-        _INDEXES[key] = GlossIndex(embedder)
+        _INDEXES[key] = GlossIndex(embedder, stored=_STORED.pop(key, None))
     return _INDEXES[key]
 
 
@@ -110,4 +159,5 @@ def purpose_categories(match: PurposeMatch, margin: float = 0.08, min_score: flo
     return best_cat, alts
 
 
-__all__ = ["GlossIndex", "PurposeMatch", "find_activity", "gloss_index", "match_purpose", "purpose_categories"]
+__all__ = ["CACHE_KEY", "GlossIndex", "PurposeMatch", "find_activity", "gloss_index", "match_purpose",
+           "purpose_categories", "use_stored_glosses"]

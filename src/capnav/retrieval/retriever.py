@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 from capnav.core.categories import NAMES
 from capnav.core.errors import InputError
 from capnav.core.grid import GridSpec
+from capnav.language import context, purpose
 from capnav.language.context import HALLWAY, ROOM_CUES, SceneContext, canonical_label
 from capnav.language.embedder import TextEmbedder
 from capnav.language.prompts import caption_name
@@ -82,7 +83,9 @@ class Retriever:
         self.objects = list(cmap.objects)
         self.E = np.stack([np.asarray(o.embedding, dtype=np.float32) for o in self.objects])
         occ = getattr(cmap, "occupancy", None)
-        self.scene = SceneContext(self.objects, occ)
+        # Walls, rooms and gloss embeddings as stored at caption time (computed here for older maps).
+        self.scene = SceneContext(self.objects, occ, store=cmap.caches.setdefault(context.CACHE_KEY, {}))
+        purpose.use_stored_glosses(embedder, cmap.caches.get(purpose.CACHE_KEY))
         self.grid = occ.spec if occ is not None else self._grid_from_objects()
         self.cells = self.grid.to_cell(np.array([o.position[:2] for o in self.objects]))
         # An object's category: the caption's name when it is a vocabulary word, else its label.
