@@ -35,30 +35,36 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Retrieve the object an instruction describes (paper 3.4); exit code 1 when nothing matches
         (0 with --json, whose payload says "found": false)."""
+        from concurrent.futures import ThreadPoolExecutor
+
         from capnav.cli.options import check_model_folder, check_verifier
-        from capnav.io.mapfile import load_map
         from capnav.language import create_embedder
         from capnav.language.embedder import EMBEDDERS
         from capnav.language.onnx_embedder import MINILM_MODEL_ID
-        from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
-        from capnav.retrieval.result import QueryResult
 
         xy = parse_xy(robot)
         check_verifier(verifier)
         if embedder != "auto":
             check_model_folder("--embedder", embedder, embedder_path, "--embedder-path", EMBEDDERS.required(embedder))
-        cmap = load_map(map_path, voxels=False)  # retrieval reads objects and occupancy only
-        if embedder == "auto":
-            models = {o.embedding_model for o in cmap.objects if o.embedding_model}
-            if not models:
-                raise InputError(f"{map_path} has no captions/embeddings: run `capnav caption {map_path} "
-                                 "--dataset DIR` first")
-            if models != {MINILM_MODEL_ID}:
-                raise InputError(f"{map_path} was embedded with {sorted(models)}; pass --embedder and "
-                                 "--embedder-path for that model")
-            emb = create_embedder("minilm")
-        else:
-            emb = create_embedder(embedder, **({"path": embedder_path} if embedder_path is not None else {}))
+        kw = {"path": embedder_path} if embedder != "auto" and embedder_path is not None else {}
+        # The embedder's ONNX session (~0.5 s, built with the GIL released) is made while the
+        # retrieval code imports and the map loads: a one-shot query's wall time on two cores.
+        with ThreadPoolExecutor(1) as pool:
+            pending = pool.submit(create_embedder, "minilm" if embedder == "auto" else embedder, **kw)
+            from capnav.io.mapfile import load_map
+            from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
+            from capnav.retrieval.result import QueryResult
+
+            cmap = load_map(map_path, voxels=False)  # retrieval reads objects and occupancy only
+            if embedder == "auto":
+                models = {o.embedding_model for o in cmap.objects if o.embedding_model}
+                if not models:
+                    raise InputError(f"{map_path} has no captions/embeddings: run `capnav caption {map_path} "
+                                     "--dataset DIR` first")
+                if models != {MINILM_MODEL_ID}:
+                    raise InputError(f"{map_path} was embedded with {sorted(models)}; pass --embedder and "
+                                     "--embedder-path for that model")
+            emb = pending.result()
         cfg = RetrievalConfig(use_verifier=verifier != "none", use_attribute_heuristic=heuristic)
         res: QueryResult = Retriever(cmap, emb, create_verifier(verifier), cfg).query(instruction, robot_xy=xy)
         if as_json:
