@@ -68,3 +68,14 @@ def test_failure_classes_and_their_table() -> None:
     assert lines[3] == "| description | cow | 5 | 1 | 1 | 1 | 1 | 1 |"  # the success is not counted
     md = render([summ("cow", "description", [0.5, 0.0, 0.0, 0.0], 0.2)], {"seed": 0}, records=recs)
     assert "## Why subgoals failed" in md and "| description | cow | 5 |" in md
+
+
+def test_a_baseline_that_ties_capnav_is_named() -> None:
+    """Category-only equal to CapNav on bare category goals is said in words, not hidden in a table."""
+    sums = [summ("capnav", "label", [1.0, 1.0, 1.0, 0.5], 0.9),
+            summ("category-only", "label", [1.0, 1.0, 1.0, 0.5], 0.9),
+            summ("vlmaps", "label", [0.5, 0.0, 0.0, 0.0], 0.4), summ("cow", "label", [1.0, 1.0, 1.0, 1.0], 0.95)]
+    md = render(sums, {"seed": 0, "scenes": 1, "scene_seeds": [0], "episodes_per_scene": 2})
+    line = next(ln for ln in md.splitlines() if ln.startswith("- paper rule:"))
+    assert "capnav 90.0%" in line and "tied by category-only" in line
+    assert "above it: cow (95.0)" in line and "below it: 1 of 3" in line

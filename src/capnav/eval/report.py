@@ -97,6 +97,28 @@ def details(summaries: Sequence[Summary]) -> list[str]:
     return lines
 
 
+def standings(summaries: Sequence[Summary], protocol: str, reference: str = "capnav") -> list[str]:
+    """One sentence per success rule naming the methods that tie or beat ``reference``: a table
+    where a baseline ties CapNav (category-only on bare category goals) says so in words."""
+    rows = {s.method: s for s in summaries if s.protocol == protocol}
+    ref = rows.get(reference)
+    if ref is None or len(rows) < 2:
+        return []
+    out = []
+    for rule, get in (("paper rule", lambda s: s.independent), ("strict", lambda s: s.independent_strict)):
+        r = get(ref)
+        if r is None:
+            continue
+        others = [(m, get(s)) for m, s in rows.items() if m != reference and get(s) is not None]
+        ties = [m for m, v in others if abs(v - r) < 5e-4]
+        above = [f"{m} ({_pct(v)})" for m, v in others if v - r >= 5e-4]
+        below = [m for m, v in others if r - v >= 5e-4]
+        out.append(f"- {rule}: {reference} {_pct(r)}% of subgoals; "
+                   f"tied by {', '.join(ties) if ties else 'no other method'}; "
+                   f"above it: {', '.join(above) if above else 'none'}; below it: {len(below)} of {len(others)}.")
+    return ["", "Standing against CapNav (independent subgoal success):", "", *out] if out else []
+
+
 def render(summaries: Sequence[Summary], config: Mapping[str, Any],
            failures: Sequence[Mapping[str, Any]] = (), timings: Mapping[str, float] | None = None,
            notes: Mapping[str, str] | None = None, records: Sequence[SubgoalRecord] = ()) -> str:
@@ -124,17 +146,20 @@ def render(summaries: Sequence[Summary], config: Mapping[str, Any],
             "footprint that no wall and no object 1 m or taller crosses (`capnav.sim.sightline`).", ""]
     out += ["", "## Table 1: multi-object navigation, label-only protocol (success %, in a row)", ""]
     out += table1(summaries, "label")
+    out += standings(summaries, "label")
     out += ["", "## Table 2: ablations (full-chain success rate and subgoal success rate, %)", ""]
     out += table2(summaries)
     out += ["", "## Description protocol: reach the one described instance among lookalikes (%)", "",
             "Not in the paper, so no paper numbers beside it.", ""]
     out += table1(summaries, "description")
+    out += standings(summaries, "description")
     if any(s.protocol == "phrasing" for s in summaries):
         out += ["", "## Free phrasings: hand-written instructions (success %)", "",
                 f"Instructions from `{config.get('instructions', 'a file')}`, one subgoal each, judged like the "
                 "description protocol; an absent target succeeds when the method answers 'not found'. "
                 "The 'in a row' columns equal the independent figure here.", ""]
         out += table1(summaries, "phrasing")
+        out += standings(summaries, "phrasing")
         if records:
             out += ["", "Successes per kind (paper rule, with the strict count):", ""]
             out += by_kind(records, "phrasing")
