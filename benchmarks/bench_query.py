@@ -22,7 +22,7 @@ from capnav.language import SceneContext, create_embedder, describe_map
 from capnav.language.colors import LEXICON
 from capnav.language.lexicon import load_lexicon
 from capnav.language.offline_captioner import ObservationCaptioner
-from capnav.language.purpose import gloss_index
+from capnav.language.purpose import GlossIndex
 from capnav.mapping.cmap import CapNavMap
 from capnav.mapping.objects import MapObject
 from capnav.mapping.voxel_map import VoxelMap
@@ -107,8 +107,11 @@ def main() -> None:
     r = Retriever(cmap, emb, create_verifier("offline"), RetrievalConfig())
     t_init = time.perf_counter() - t
 
+    # The glosses' embeddings: paid by describe_map, which stores them in the map (and by the first
+    # request by purpose on a map captioned before that), not by the retriever above.
+    emb._cache.clear()
     t = time.perf_counter()
-    gloss_index(emb)  # the first request by purpose pays the glosses' embeddings, once per embedder
+    GlossIndex(emb)
     t_gloss = time.perf_counter() - t
     qs = instructions(args.queries, args.seed)
     parts: dict[str, list[float]] = {"embed": [], "rank": [], "verify": [], "total": []}
@@ -149,7 +152,7 @@ def main() -> None:
     print(f"{'describe_map (no views)':34s} {t_describe * 1e3:11.0f} ms {'':>26s}")
     print(f"{'retriever init':34s} {t_init * 1e3:11.0f} ms {'':>26s}")
     print(f"{'WordNet lexicon load (once)':34s} {max(t_lex, lex.load_seconds) * 1e3:11.1f} ms {'':>26s}")
-    print(f"{'purpose glosses embedded (once)':34s} {t_gloss * 1e3:11.0f} ms {'':>26s}")
+    print(f"{'purpose glosses embedded (caption)':34s} {t_gloss * 1e3:11.0f} ms {'':>26s}")
     for k in ("embed", "rank", "verify", "total"):
         print(f"{'query ' + k + ' p50 / p95':34s} {pct(parts[k], 50):5.1f} /{pct(parts[k], 95):5.1f} ms"
               + (f" {'target p95 <= 50 ms':>26s}" if k == "total" else ""))
