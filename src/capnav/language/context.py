@@ -112,7 +112,7 @@ class SceneContext:
         self.region = np.full(n, -1, dtype=np.int64)  # room region per object (-1: no walls known)
         self.region_rooms: dict[int, tuple[str | None, dict[str, float]]] = {}
         digest = self._digest()
-        if not (self.store is not None and self.store.get("digest") == digest and self._restore(self.store)):
+        if not (self.store is not None and digest and self.store.get("digest") == digest and self._restore(self.store)):
             self.visible = self._line_of_sight()
             self.room_score = self._room_scores()
             if self.occupancy is not None and n:
@@ -127,7 +127,10 @@ class SceneContext:
         """sha256 of every input of the walls and rooms, and of the code that computes them."""
         h = hashlib.sha256()
         for src in _SOURCES:
-            h.update(src.read_bytes())
+            try:
+                h.update(src.read_bytes())
+            except OSError:  # no source to key on (a bytecode-only install): never read the store
+                return ""
         h.update(json.dumps([dataclasses.asdict(self.config), self.labels, [o.id for o in self.objects]]).encode())
         for a in (self.lo, self.hi, self.xy):
             h.update(np.ascontiguousarray(a, dtype="<f8").tobytes())
