@@ -14,6 +14,13 @@ manifest: colour name, room, model size), never from instructions:
   below which size words cannot rank two instances is its 95th percentile.
 * room: the inferred room against the room that holds the object's centre (inferred, unknown,
   wrong), which bounds how often a room refusal ("the X in the kitchen") may be wrong.
+* surface (``capnav.language.surface``): the woven / smooth word the pixels gave against the
+  true material; how often a spoken material would be refused for the object's own material,
+  and for a material of the other kind (a weave for a smooth one and back).
+* shape (``capnav.language.form``): the shape words the points gave against the true shape
+  variant, on the categories whose variants carry the word (round / rectangular tables, stools and
+  ottomans; cactus or leafy plants); how often a spoken shape word would be refused for the
+  object's own shape, and the opposite word.
 
     .venv/bin/python benchmarks/measure_evidence.py --seeds 1 2 3 --work /tmp/capnav-eval
 
@@ -34,9 +41,79 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from capnav.language import SceneContext, create_embedder
 from capnav.language.colors import LEX_LAB, NAMES, canonical_color, ciede2000
 from capnav.language.context import label_of
+from capnav.language.form import shape_conflict
+from capnav.language.surface import WOVEN_MATERIALS, material_conflict
 from capnav.retrieval.query import ParsedQuery
 from capnav.retrieval.verifier import OfflineVerifier, OfflineVerifierConfig, shades
 from eval_retrieval import build, instance_of
+
+#: Shape words each (category, truth variant) deserves and the word that would be wrong for it.
+_ROUNDABLE = ("table", "coffee table", "stool", "ottoman")
+
+
+def true_shape(category: str, variant: str) -> tuple[str, str] | None:
+    """(right word, wrong word) for an instance, or None when its variant says nothing measurable."""
+    if category in _ROUNDABLE:
+        return ("round", "rectangular") if variant == "round" else ("rectangular", "round")
+    if category == "plant":
+        return ("slender", "bushy") if variant == "cactus" else ("bushy", "slender")
+    return None
+
+
+def material_word(material: str) -> str:
+    return material.split()[-1]  # "stainless steel" is spoken "steel"
+
+
+def report_form(rows: list[tuple[str, str, str, list[str], str | None]]) -> None:
+    """rows: (category, variant, material, observed shape words, observed surface word)."""
+    print(f"\nsurface words against the true material ({len(rows)} mapped objects)")
+    print("| true material | n | woven | smooth | nothing |")
+    print("|---|---:|---:|---:|---:|")
+    by_mat: dict[str, Counter[str | None]] = {}
+    for _, _, mat, _, surf in rows:
+        by_mat.setdefault(mat, Counter())[surf] += 1
+    for mat in sorted(by_mat):
+        c = by_mat[mat]
+        print(f"| {mat} | {sum(c.values())} | {c['woven']} | {c['smooth']} | {c[None]} |")
+    woven = [material_word(m) in WOVEN_MATERIALS for _, _, m, _, s in rows if s == "woven"]
+    smooth = [material_word(m) not in WOVEN_MATERIALS for _, _, m, _, s in rows if s == "smooth"]
+    fabric = [s == "woven" for _, _, m, _, s in rows if material_word(m) in WOVEN_MATERIALS]
+    print(f"| 'woven' right | {len(woven)} | {np.mean(woven):.1%} | | |" if woven else "| 'woven' never said | | | | |")
+    print(f"| 'smooth' right | {len(smooth)} | {np.mean(smooth):.1%} | | |" if smooth else "| 'smooth' never said |")
+    if fabric:
+        print(f"| fabric / cotton called woven | {len(fabric)} | {np.mean(fabric):.1%} | | |")
+    own = [bool(material_conflict(material_word(m), s)) for _, _, m, _, s in rows]
+    other = [bool(material_conflict("leather" if material_word(m) in WOVEN_MATERIALS else "fabric", s))
+             for _, _, m, _, s in rows if m not in ("mesh",)]
+    print(f"own material refused: {np.mean(own):.1%} of {len(own)}; the other kind's word (fabric <-> leather) "
+          f"refused: {np.mean(other):.1%} of {len(other)}")
+    print("\nshape words against the true variant (categories whose variants carry a word)")
+    print("| word | said | right | precision |")
+    print("|---|---:|---:|---:|")
+    said: Counter[str] = Counter()
+    right: Counter[str] = Counter()
+    own_ref, wrong_ref = [], []
+    for cat, var, _, words, _ in rows:
+        t = true_shape(cat, var)
+        if t is None:
+            continue
+        for w in words:
+            if w in t:  # a word of this category's pair: right or wrong for this instance
+                said[w] += 1
+                right[w] += w == t[0]
+        own_ref.append(shape_conflict(t[0], words) is not None)
+        wrong_ref.append(shape_conflict(t[1], words) is not None)
+    for w in sorted(said):
+        print(f"| {w} | {said[w]} | {right[w]} | {right[w] / said[w]:.1%} |")
+    print(f"own shape word refused: {np.mean(own_ref):.1%} of {len(own_ref)}; the opposite word refused: "
+          f"{np.mean(wrong_ref):.1%} of {len(wrong_ref)}")
+    print("\nobserved shape words by true variant:")
+    table: dict[tuple[str, str], Counter[str]] = {}
+    for cat, var, _, words, _ in rows:
+        if true_shape(cat, var) is not None:
+            table.setdefault((cat, var), Counter())[" ".join(words) or "-"] += 1
+    for (cat, var), c in sorted(table.items()):
+        print(f"  {cat} / {var}: " + ", ".join(f"{k} {n}" for k, n in c.most_common()))
 
 
 def main() -> None:
@@ -54,6 +131,7 @@ def main() -> None:
     ratios: list[float] = []
     rooms: Counter[str] = Counter()
     room_rows = []
+    form_rows: list[tuple[str, str, str, list[str], str | None]] = []
     for seed in args.seeds:
         cmap, manifest = build(seed, args.work)
         scene = SceneContext(cmap.objects, cmap.occupancy)
@@ -75,6 +153,7 @@ def main() -> None:
                 # a dark grey object: people say that).
                 for w in (NAMES[k] for k in np.flatnonzero(d > args.far) if word not in shades(NAMES[k])):
                     wrong_agree.append(judge.color(ParsedQuery(text=text, colors=[w]), o)[0])
+            form_rows.append((truth.category, truth.shape, truth.material, judge.shapes(o), judge.surface(o).word))
             said = scene.room_of(o)
             real = room_name[truth.room]
             verdict = "unknown" if said is None else ("right" if said == real else "wrong")
@@ -114,6 +193,7 @@ def main() -> None:
           f"{rooms['unknown'] / total:.1%} / {rooms['wrong'] / total:.1%} |")
     for row in room_rows:
         print(f"  wrong room: {row}")
+    report_form(form_rows)
 
 
 if __name__ == "__main__":

@@ -135,3 +135,41 @@ def walked_through_the_door(map_file: Path) -> CapNavMap:
                                                                    for x in xs]))
     return cmap
 
+
+def textured_view(obj: MapObject, pattern: str, scale: float = 1.0) -> MapObject:
+    """Give ``obj`` one view: a crop of the simulator's ``pattern`` texture in the object's median
+    point colour, resampled by ``scale`` (as a renderer samples it), on a wall-coloured margin."""
+    import io
+
+    from PIL import Image
+
+    from capnav.mapping.objects import ObjectView
+    from capnav.sim.textures import texture
+
+    rgb = tuple(int(v) for v in np.median(np.asarray(obj.colors), axis=0))
+    tile = np.tile(texture(pattern, rgb), (2, 2, 1))  # type: ignore[arg-type]
+    n = int(128 * scale)
+    surf = np.asarray(Image.fromarray(tile).resize((n, n), Image.BILINEAR))
+    img = np.full((n + 40, n + 40, 3), (205, 200, 190), np.uint8)
+    img[20:20 + n, 20:20 + n] = surf
+    buf = io.BytesIO()
+    Image.fromarray(img).save(buf, format="PNG")
+    obj.views = [ObjectView(0, (0.0, 0.0, float(n + 40), float(n + 40)), 1.0, b"", buf.getvalue())]
+    return obj
+
+
+def disc_points(center: tuple[float, float], radius: float, height: float, n: int = 2000,
+                seed: int = 0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    t, r = rng.uniform(0, 2 * np.pi, n), radius * np.sqrt(rng.uniform(0, 1, n))
+    return np.stack([center[0] + r * np.cos(t), center[1] + r * np.sin(t), rng.uniform(0, height, n)],
+                    1).astype(np.float32)
+
+
+def plant_points(center: tuple[float, float], foliage_radius: float, seed: int = 0) -> np.ndarray:
+    """A pot (radius 0.15 m, 0.3 m high) with a foliage column of ``foliage_radius`` up to 1.1 m."""
+    rng = np.random.default_rng(seed)
+    pot = disc_points(center, 0.15, 0.3, 600, seed)
+    leaves = disc_points(center, foliage_radius, 0.8, 1500, seed + 1)
+    leaves[:, 2] += 0.3
+    return np.concatenate([pot, leaves])[rng.permutation(2100)].astype(np.float32)

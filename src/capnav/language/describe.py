@@ -2,8 +2,9 @@
 
 Captions are cached in ``cmap.caches["captions"]`` under the captioner's ``cache_key`` (a hash of
 the views' content, the prompt and the model), so a rerun is free and reproducible; the cache
-travels inside the map file, as the paper released its cached captions. The measured colours go
-to ``cmap.caches["attributes"]`` so that verification does not recompute them per query.
+travels inside the map file, as the paper released its cached captions. The measured colours,
+shape words and surface go to ``cmap.caches["attributes"]`` so that verification does not
+recompute them per query.
 """
 
 from __future__ import annotations
@@ -77,6 +78,8 @@ def describe_map(cmap: CapNavMap, reader: FrameReader | None, captioner: Caption
         attrs[str(obj.id)] = {key: [[c.name, *[round(v, 3) for v in c.lab], round(c.fraction, 4),
                                      round(c.distance, 3)] for c in cols]
                               for key, cols in (("colors", namer.colors(obj)), ("base_colors", namer.base_colors(obj)))}
+        attrs[str(obj.id)]["shapes"] = namer.shapes(obj)
+        attrs[str(obj.id)]["surface"] = namer.surface(obj).to_list()
     t2 = time.perf_counter()
     texts = [o.caption or "" for o in cmap.objects]
     if texts:

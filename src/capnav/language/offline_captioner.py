@@ -19,7 +19,9 @@ from numpy.typing import NDArray
 from capnav.language.captioner import CAPTIONERS, Caption, Captioner
 from capnav.language.colors import ColorCluster, ColorConfig, object_colors
 from capnav.language.context import SceneContext, canonical_label, label_of
+from capnav.language.form import FormConfig, growth, outline
 from capnav.language.prompts import MAX_CAPTION_WORDS
+from capnav.language.surface import Surface, SurfaceConfig, surface_of
 from capnav.mapping.objects import MapObject
 
 _COUNT = {2: "two", 3: "three", 4: "four", 5: "five", 6: "six", 7: "seven", 8: "eight"}
@@ -40,10 +42,8 @@ class OfflineCaptionConfig:
     colors: ColorConfig = field(default_factory=ColorConfig)
     second_color_fraction: float = 0.25  # report a second colour when it covers this share
     min_points: int = 30  # fewer fused points than this: use the views' pixels for colour
-    round_circularity: float = 0.86  # 4*pi*A/P^2 of the footprint hull (square: 0.785)
-    l_shape_fill: float = 0.86  # occupied share of the footprint hull below which it is L-shaped
-    l_shape_min_area: float = 1.5  # m² of hull: only sofa/counter-sized objects can be L-shaped
-    long_aspect: float = 2.3
+    form: FormConfig = field(default_factory=FormConfig)  # shape words from the points
+    surface: SurfaceConfig = field(default_factory=SurfaceConfig)  # woven / smooth from the pixels
     base_fraction: float = 0.3  # lowest share of the height that holds a plant's pot
 
 
@@ -69,46 +69,18 @@ def view_pixels(obj: MapObject, max_views: int = 5) -> NDArray[np.uint8]:
 
 
 def footprint_shape(obj: MapObject, cfg: OfflineCaptionConfig) -> str | None:
-    """"round", "L-shaped" or "long" from the top-down point footprint, else None."""
-    pts = np.asarray(obj.points, dtype=np.float64)
-    if len(pts) < 40:
-        return None
-    from scipy.spatial import ConvexHull, QhullError
+    """"L-shaped", "round", "long" or "rectangular" from the top-down point footprint, else None."""
+    return outline(np.asarray(obj.points, dtype=np.float64), cfg.form)
 
-    xy = pts[:, :2]
-    try:
-        hull = ConvexHull(xy)
-    except (QhullError, ValueError):
-        return None
-    area, perim = float(hull.volume), float(hull.area)
-    if area < 0.02:
-        return None
-    # Occupied share of the hull, both counted on the same grid (cells whose centre is inside).
-    res = max(0.04, np.sqrt(area / 400.0))
-    origin = xy.min(0)
-    cells = np.unique(np.floor((xy - origin) / res).astype(np.int64), axis=0)
-    span = np.floor((xy.max(0) - origin) / res).astype(np.int64) + 1
-    gx, gy = np.meshgrid(np.arange(span[0]), np.arange(span[1]), indexing="ij")
-    centres = origin + (np.stack([gx.ravel(), gy.ravel()], 1) + 0.5) * res
-    eq = hull.equations  # inside: n . p + d <= 0 for every facet
-    in_hull = int(np.all(centres @ eq[:, :2].T + eq[:, 2] <= 1e-9, axis=1).sum())
-    occ = len(cells) / max(in_hull, 1)
-    centered = xy - xy.mean(0)
-    ev = np.linalg.eigvalsh(np.cov(centered.T))
-    aspect = float(np.sqrt(max(ev[1], 1e-9) / max(ev[0], 1e-9)))
-    if occ < cfg.l_shape_fill and aspect < 2.0 and area >= cfg.l_shape_min_area:
-        return "L-shaped"
-    if 4 * np.pi * area / perim**2 >= cfg.round_circularity and aspect < 1.25:
-        return "round"
-    if aspect >= cfg.long_aspect:
-        return "long"
-    return None
+
+#: Categories that grow (foliage over a pot).
+_GROWING = {"plant"}
 
 
 class ObservationCaptioner(Captioner):
     """Writes "NAME, one sentence" from the map's observations (no model, deterministic)."""
 
-    model_id = "offline-observation-v1"
+    model_id = "offline-observation-v2"  # v2: surface, rectangular and growth words
 
     def __init__(self, config: OfflineCaptionConfig | None = None) -> None:
         self.config = config or OfflineCaptionConfig()
@@ -132,6 +104,28 @@ class ObservationCaptioner(Captioner):
         low = rgb[z <= lo + self.config.base_fraction * max(hi - lo, 1e-6)]
         return object_colors(low.reshape(-1, 3), self.config.colors) if len(low) >= 10 else []
 
+    def surface(self, obj: MapObject) -> Surface:
+        """Woven or smooth from the views' pixels around the object's median observed colour."""
+        from capnav.language.colors import srgb_to_lab
+
+        rgb = np.asarray(obj.colors).reshape(-1, 3)
+        if len(rgb) < self.config.min_points:
+            px = view_pixels(obj)
+            rgb = px if len(px) > len(rgb) else rgb
+        ref = tuple(float(x) for x in np.median(srgb_to_lab(rgb), axis=0)) if len(rgb) else None
+        return surface_of(obj, ref, self.config.surface)  # type: ignore[arg-type]
+
+    def shapes(self, obj: MapObject, name: str | None = None) -> list[str]:
+        """Observed shape words: the footprint's, then a plant's growth; empty when the points say
+        nothing clearly."""
+        name = name or vote_label(obj)
+        pts = np.asarray(obj.points, dtype=np.float64)
+        out = [w for w in (outline(pts, self.config.form),) if w]
+        if name in _GROWING:
+            w = growth(pts, self.config.form)
+            out += [w] if w else []
+        return out
+
     def color_phrase(self, obj: MapObject) -> str | None:
         cols = self.colors(obj)
         if not cols:
@@ -154,9 +148,12 @@ class ObservationCaptioner(Captioner):
         size = obj.size
         out["width"] = f"{max(float(size[0]), float(size[1])):.1f} m wide"
         out["height"] = f"{float(size[2]):.1f} m tall"
-        shape = footprint_shape(obj, self.config)
-        if shape:
-            out["shape"] = shape
+        shapes = self.shapes(obj, name)
+        if shapes:
+            out["shape"] = " ".join(shapes)
+        surface = self.surface(obj).word
+        if surface:
+            out["surface"] = "fabric" if surface == "woven" else surface
         if obj.id in scene.index:
             rank, count = scene.size_rank(obj)
             if count == 2:
@@ -175,9 +172,9 @@ class ObservationCaptioner(Captioner):
         return out
 
     def compose(self, p: dict[str, str]) -> str:
-        """"NAME, a <size> <colour> <shape> <name>, W m wide and H m tall, <relative>, <near> <room>."
-        Optional clauses are dropped (relative size first) until the sentence fits 25 words."""
-        adjs = " ".join(x for x in (p.get("size"), p.get("color"), p.get("shape")) if x)
+        """"NAME, a <size> <colour> <surface> <shape> <name>, W m wide and H m tall, <relative>, <near>
+        <room>." Optional clauses are dropped (relative size first) until the sentence fits 25 words."""
+        adjs = " ".join(x for x in (p.get("size"), p.get("color"), p.get("surface"), p.get("shape")) if x)
         head = f"{adjs} {p['name']}" if adjs else p["name"]
         head = ("an " if head[0] in "aeiouAEIOU" else "a ") + head
         if "pot" in p:

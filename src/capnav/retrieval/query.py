@@ -90,7 +90,9 @@ _SIZE_WORDS.update(_LEX.sizes)
 _SIZE_TOKENS = {w for f in _SIZE_WORDS for w in f.split()}
 _SHAPES = {"round": "round", "circular": "round", "l-shaped": "L-shaped", "l shaped": "L-shaped",
            "corner": "L-shaped", "long": "long", "rectangular": "rectangular", "square": "square",
-           "curved": "curved", "oval": "round"}
+           "curved": "curved", "oval": "round",
+           # the growth words the offline captioner says of a plant (capnav.language.form)
+           "bushy": "bushy", "slender": "slender"}
 #: Relations whose geometry the retriever measures beyond the gap: "between" two landmarks
 #: (``anchor2_category``), "at the end of" a long object (the ends of its long axis), and
 #: "in the room with" a landmark (its room region).

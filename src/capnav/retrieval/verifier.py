@@ -6,7 +6,9 @@ strict parsing (off-schema answers are retried, then the offline verifier decide
 says so); ``offline`` with the same interface, judging agreement between the instruction's target
 and each caption's object name (same category, or embedding similarity of the names) plus
 attribute agreement (colour by CIEDE2000 against the object's measured colour, size words
-against its size among its category, shape words against its caption); ``none`` accepts the
+against its size among its category, shape words against the shape words its points gave and
+material words against the surface its pixels showed, a contradiction being a refusal);
+``none`` accepts the
 first candidate. Decisions are cached (in the map's ``caches["verifications"]`` when given).
 """
 
@@ -30,8 +32,10 @@ from capnav.language.colors import NAMES as COLOR_NAMES
 from capnav.language.colors import ColorCluster, canonical_color, color_agreement
 from capnav.language.context import SceneContext, canonical_label
 from capnav.language.embedder import TextEmbedder
+from capnav.language.form import shape_conflict
 from capnav.language.offline_captioner import ObservationCaptioner
 from capnav.language.prompts import Verdict, caption_name, parse_verdict, verification_prompt
+from capnav.language.surface import Surface, material_conflict
 from capnav.language.vlm.base import RateLimited, VisionLanguageModel, create_vlm
 from capnav.mapping.objects import MapObject
 from capnav.retrieval.query import ParsedQuery
@@ -141,6 +145,7 @@ class OfflineVerifierConfig:
     w_color: float = 1.0
     w_size: float = 0.6
     w_shape: float = 0.3
+    w_material: float = 0.3
     w_alternative: float = 0.5  # value lost by an alternative category at weight 0
 
 
@@ -154,6 +159,8 @@ class OfflineVerifier(Verifier):
         self.config = config or OfflineVerifierConfig()
         self._colors: dict[int, list[ColorCluster]] = {}
         self._base_colors: dict[int, list[ColorCluster]] = {}
+        self._shapes: dict[int, list[str]] = {}
+        self._surfaces: dict[int, Surface] = {}
         self._captioner = ObservationCaptioner()
         self._name_sims: dict[tuple[str, str], float] = {}
 
@@ -162,13 +169,17 @@ class OfflineVerifier(Verifier):
         self.scene = scene
 
     def use_attributes(self, attributes: dict[str, Any]) -> None:
-        """Colours measured by ``describe_map`` (``cmap.caches["attributes"]``), so queries need not
-        recompute them."""
+        """Colours, shape words and surfaces measured by ``describe_map`` (``cmap.caches["attributes"]``),
+        so queries need not recompute them."""
         for key, rec in attributes.items():
             for field_, store in (("colors", self._colors), ("base_colors", self._base_colors)):
                 if field_ in rec:
                     store[int(key)] = [ColorCluster(str(n), (float(L), float(a), float(b)), float(f), float(d))
                                        for n, L, a, b, f, d in rec[field_]]
+            if "shapes" in rec:
+                self._shapes[int(key)] = [str(w) for w in rec["shapes"]]
+            if "surface" in rec:
+                self._surfaces[int(key)] = Surface.from_list(rec["surface"])
 
     def colors(self, obj: MapObject) -> list[ColorCluster]:
         if obj.id not in self._colors:
@@ -179,6 +190,45 @@ class OfflineVerifier(Verifier):
         if obj.id not in self._base_colors:
             self._base_colors[obj.id] = self._captioner.base_colors(obj)
         return self._base_colors[obj.id]
+
+    def shapes(self, obj: MapObject) -> list[str]:
+        if obj.id not in self._shapes:
+            self._shapes[obj.id] = self._captioner.shapes(obj)
+        return self._shapes[obj.id]
+
+    def surface(self, obj: MapObject) -> Surface:
+        if obj.id not in self._surfaces:
+            self._surfaces[obj.id] = self._captioner.surface(obj)
+        return self._surfaces[obj.id]
+
+    def shape(self, q: ParsedQuery, obj: MapObject) -> tuple[float | None, str]:
+        """(agreement in [0, 1], why) of the spoken shape words with the observed ones (or the
+        caption's words, for a model's caption); None when an observed word contradicts one."""
+        if not q.shapes:
+            return 0.0, ""
+        seen = self.shapes(obj)
+        for w in q.shapes:
+            bad = shape_conflict(w, seen)
+            if bad is not None:
+                return None, f"'{w}' but its points are {bad}"
+        text = (obj.caption or "").lower()
+        agree = float(np.mean([w in seen or w.lower() in text for w in q.shapes]))
+        return agree, f"shape {'/'.join(q.shapes)} vs observed {'/'.join(seen) or 'nothing clear'}"
+
+    def material(self, q: ParsedQuery, obj: MapObject) -> tuple[float | None, str]:
+        """(agreement in [0, 1], why) of the spoken materials with the surface the pixels showed:
+        1 agrees, 0.5 says nothing about a weave or nothing was seen; None contradicts."""
+        if not q.materials:
+            return 0.0, ""
+        surf = self.surface(obj)
+        vals = []
+        for m in q.materials:
+            c = material_conflict(m, surf.word)
+            if c:
+                return None, (f"'{m}' but its pixels show a {surf.word} surface (finest/next band "
+                              f"{surf.ratio:.2f})")
+            vals.append(0.5 if c is None else 1.0)
+        return float(np.mean(vals)), f"material {'/'.join(q.materials)} vs {surf.word or 'no clear'} surface"
 
     def _name_sim(self, noun: str, name: str) -> float:
         key = (noun, name)
@@ -258,13 +308,19 @@ class OfflineVerifier(Verifier):
         size = self.size(query, c.obj)
         if query.size_word:
             terms["size"] = round(size, 3)
-        shape = 0.0
-        if query.shapes and c.obj.caption:
-            shape = float(np.mean([s.lower() in c.obj.caption.lower() for s in query.shapes]))
+        shape, swhy = self.shape(query, c.obj)
+        if shape is None:
+            return Assessment(False, 0.0, terms, f"{why} but {swhy}")
+        if query.shapes:
             terms["shape"] = round(shape, 3)
+        mat, mwhy = self.material(query, c.obj)
+        if mat is None:
+            return Assessment(False, 0.0, terms, f"{why} but {mwhy}")
+        if query.materials:
+            terms["material"] = round(mat, 3)
         val = (cfg.w_rank * (1.0 - position) + cfg.w_color * col + cfg.w_size * size + cfg.w_shape * shape
-               - cfg.w_alternative * (1.0 - weight))
-        return Assessment(True, float(val), terms, "; ".join(x for x in (why, cwhy) if x))
+               + cfg.w_material * mat - cfg.w_alternative * (1.0 - weight))
+        return Assessment(True, float(val), terms, "; ".join(x for x in (why, cwhy, swhy, mwhy) if x))
 
     def verify(self, query: ParsedQuery, batch: list[Candidate]) -> Verdict:
         best: tuple[int, float, int, str] | None = None

@@ -1,0 +1,90 @@
+"""Shape words from points and surface words from pixels: said when clear, nothing when weak.
+
+Inputs are synthetic: point sets drawn for each shape, and view crops of the simulator's procedural
+material textures (the pixels the renderer samples), never a scene's truth.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from capnav.language import SceneContext
+from capnav.language.form import growth, outline, shape_conflict
+from capnav.language.offline_captioner import ObservationCaptioner
+from capnav.language.surface import Surface, material_conflict, surface_of
+
+from .synth import disc_points, make_obj, plant_points, textured_view
+
+
+def _board(w: float, d: float, seed: int = 0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    return np.stack([rng.uniform(0, w, 3000), rng.uniform(0, d, 3000), rng.uniform(0, 0.7, 3000)],
+                    1).astype(np.float32)
+
+
+def test_outline_round_rectangular_long():
+    assert outline(disc_points((0, 0), 0.45, 0.5)) == "round"
+    assert outline(_board(1.0, 0.6)) == "rectangular"  # a coffee table's top
+    assert outline(_board(0.5, 0.5)) == "rectangular"  # a square stool is not round
+    assert outline(_board(2.4, 0.6)) == "long"
+    assert outline(_board(1.0, 0.6)[:20]) is None  # too few points to say
+
+
+def test_a_plant_is_bushy_when_its_foliage_spreads_wider_than_its_pot_and_slender_when_narrower():
+    assert growth(plant_points((0, 0), 0.35)) == "bushy"
+    assert growth(plant_points((0, 0), 0.06)) == "slender"  # a columnar cactus
+    assert growth(plant_points((0, 0), 0.14)) is None  # about the pot's width: nothing clear
+
+
+def test_weave_is_woven_and_grain_mottle_veins_and_pile_are_smooth():
+    cap = ObservationCaptioner()
+    words = {}
+    for k, pattern in enumerate(("fabric", "cotton", "leather", "wood", "marble", "metal")):
+        o = textured_view(make_obj(k + 1, "armchair", (0, 0), (0.8, 0.8, 0.9), (170, 60, 70),
+                                   shading=(1.0, 1.0)), pattern)
+        words[pattern] = cap.surface(o).word
+    assert words == {"fabric": "woven", "cotton": "woven", "leather": "smooth", "wood": "smooth",
+                     "marble": "smooth", "metal": "smooth"}
+
+
+def test_a_plain_painted_surface_is_smooth():
+    o = textured_view(make_obj(1, "cabinet", (0, 0), (1.0, 0.5, 0.9), (90, 120, 200), shading=(1.0, 1.0)), "plain")
+    assert ObservationCaptioner().surface(o).word == "smooth"
+
+
+def test_nothing_is_said_without_views_or_when_no_pixel_has_the_objects_colour():
+    o = make_obj(1, "sofa", (0, 0), (2.0, 0.9, 0.8), (40, 140, 50))
+    assert ObservationCaptioner().surface(o).word is None  # no views
+    textured_view(o, "fabric")
+    assert surface_of(o, (50.0, -60.0, 60.0)).word is None  # crops show another colour only
+
+
+def test_surface_round_trips_through_the_attribute_cache():
+    s = Surface("woven", 1.734, 0.61, 5000)
+    assert Surface.from_list(s.to_list()) == s
+    none = Surface(None, float("nan"), 0.0, 0)
+    back = Surface.from_list(none.to_list())
+    assert back.word is None and np.isnan(back.ratio)
+
+
+def test_conflicts_are_only_the_measured_ones():
+    assert material_conflict("leather", "woven") and material_conflict("cotton", "smooth")
+    assert material_conflict("velvet", "smooth") is False  # a pile hides its weave
+    assert material_conflict("fabric", None) is None and material_conflict("gold", "smooth") is None
+    assert shape_conflict("round", ["rectangular"]) == "rectangular"
+    assert shape_conflict("square", ["round"]) is None  # "round" was said of some square stools
+    assert shape_conflict("slender", ["bushy"]) == "bushy"
+
+
+def test_the_caption_says_the_surface_and_shape_it_observed():
+    table = make_obj(1, "table", (0, 0), (0.9, 0.9, 0.75), (150, 110, 70), shading=(1.0, 1.0))
+    table.points = disc_points((0, 0), 0.45, 0.75)
+    sofa = textured_view(make_obj(2, "sofa", (3, 0), (2.0, 0.9, 0.8), (40, 140, 50), shading=(1.0, 1.0)), "fabric")
+    plant = make_obj(3, "plant", (5, 0), (0.7, 0.7, 1.1), (50, 125, 45))
+    plant.points = plant_points((5, 0), 0.35)
+    scene = SceneContext([table, sofa, plant])
+    cap = ObservationCaptioner()
+    texts = {o.id: cap.caption(o, scene).text for o in (table, sofa, plant)}
+    assert "round table" in texts[1]
+    assert "green fabric" in texts[2] and "sofa" in texts[2]
+    assert "bushy plant" in texts[3]

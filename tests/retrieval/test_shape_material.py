@@ -1,0 +1,94 @@
+"""Material and shape words against what the map observed: agreement ranks higher, a clear
+contradiction is refused with the reason, weak evidence decides nothing.
+
+One living room of synthetic objects whose views are crops of the simulator's procedural
+textures and whose points are drawn for their shape; sentences are written for this scene, none
+is taken from the development phrasings.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from capnav.language import create_captioner, create_embedder
+from capnav.language.describe import describe_map
+from capnav.retrieval import Retriever
+from language.synth import disc_points, make_map, make_obj, plant_points, textured_view
+
+
+@pytest.fixture(scope="module")
+def emb():
+    return create_embedder("minilm")
+
+
+def _board(center: tuple[float, float], w: float, d: float):
+    import numpy as np
+
+    rng = np.random.default_rng(7)
+    return np.stack([center[0] - w / 2 + rng.uniform(0, w, 3000), center[1] - d / 2 + rng.uniform(0, d, 3000),
+                     rng.uniform(0, 0.75, 3000)], 1).astype(np.float32)
+
+
+def room(keep: set[int] | None = None) -> list:
+    pink = (235, 140, 180)
+    objs = [
+        textured_view(make_obj(1, "armchair", (1.0, 1.0), (0.8, 0.8, 0.9), pink, shading=(1.0, 1.0)), "fabric"),
+        textured_view(make_obj(2, "armchair", (4.0, 1.0), (0.8, 0.8, 0.9), pink, shading=(1.0, 1.0)), "leather"),
+        make_obj(3, "table", (1.5, 4.0), (0.9, 0.9, 0.75), (150, 110, 70)),
+        make_obj(4, "table", (4.5, 4.0), (1.2, 0.8, 0.75), (150, 110, 70)),
+        make_obj(5, "plant", (7.0, 1.0), (0.7, 0.7, 1.1), (50, 125, 45)),
+        make_obj(6, "plant", (7.0, 4.5), (0.3, 0.3, 1.1), (50, 125, 45)),
+    ]
+    objs[2].points = disc_points((1.5, 4.0), 0.45, 0.75)
+    objs[3].points = _board((4.5, 4.0), 1.2, 0.8)
+    objs[4].points = plant_points((7.0, 1.0), 0.35)
+    objs[5].points = plant_points((7.0, 4.5), 0.06)
+    return [o for o in objs if keep is None or o.id in keep]
+
+
+def retriever(emb, keep: set[int] | None = None) -> Retriever:
+    cmap = make_map(room(keep))
+    describe_map(cmap, None, create_captioner("offline"), emb, progress=False)
+    return Retriever(cmap, emb)
+
+
+def test_the_observed_words_reach_the_attribute_cache(emb):
+    cmap = make_map(room())
+    describe_map(cmap, None, create_captioner("offline"), emb, progress=False)
+    attrs = cmap.caches["attributes"]
+    assert attrs["1"]["surface"][0] == "woven" and attrs["2"]["surface"][0] == "smooth"
+    assert attrs["3"]["shapes"] == ["round"] and attrs["4"]["shapes"] == ["rectangular"]
+    assert "bushy" in attrs["5"]["shapes"] and "slender" in attrs["6"]["shapes"]
+
+
+def test_material_agreement_chooses_between_lookalikes(emb):
+    r = retriever(emb)
+    assert r.query("could you take me to the leather armchair").chosen.id == 2
+    res = r.query("the pink fabric armchair please")
+    assert res.chosen.id == 1 and res.terms.get("material") == 1.0
+
+
+def test_a_material_the_pixels_contradict_is_refused_with_the_reason(emb):
+    only_woven = retriever(emb, {1, 3, 4, 5, 6})
+    res = only_woven.query("go to the leather armchair")
+    assert not res.found and "woven" in res.reason
+    only_smooth = retriever(emb, {2, 3, 4, 5, 6})
+    assert not only_smooth.query("find the cotton armchair").found
+    # Velvet's pile shows no weave: a smooth armchair may be velvet.
+    assert only_smooth.query("find the velvet armchair").chosen.id == 2
+
+
+def test_round_and_rectangular_tables(emb):
+    r = retriever(emb)
+    assert r.query("head to the round table").chosen.id == 3
+    assert r.query("the rectangular table").chosen.id == 4
+    res = retriever(emb, {1, 2, 4, 5, 6}).query("head to the round table")
+    assert not res.found and "rectangular" in res.reason
+
+
+def test_plant_growth_words(emb):
+    r = retriever(emb)
+    assert r.query("the bushy plant").chosen.id == 5
+    assert r.query("take me to the slender plant").chosen.id == 6
+    res = retriever(emb, {1, 2, 3, 4, 5}).query("take me to the slender plant")
+    assert not res.found and "bushy" in res.reason
