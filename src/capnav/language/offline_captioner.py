@@ -151,9 +151,8 @@ class ObservationCaptioner(Captioner):
         shapes = self.shapes(obj, name)
         if shapes:
             out["shape"] = " ".join(shapes)
-        surface = self.surface(obj).word
-        if surface:
-            out["surface"] = "fabric" if surface == "woven" else surface
+        if self.surface(obj).word == "woven":  # "smooth" is said of most objects: no word singles one out
+            out["surface"] = "fabric"
         if obj.id in scene.index:
             rank, count = scene.size_rank(obj)
             if count == 2:
@@ -198,6 +197,7 @@ class ObservationCaptioner(Captioner):
     def cache_key(self, obj: MapObject, scene: SceneContext) -> str:
         """The offline caption depends on the observations and the neighbours, not on pixels only."""
         h = hashlib.sha256(self.model_id.encode())
+        h.update(repr(self.config).encode())  # thresholds change the words
         h.update(repr(sorted(obj.label_votes.items())).encode())
         h.update(np.ascontiguousarray(obj.colors).tobytes())
         h.update(np.ascontiguousarray(obj.points).tobytes())

@@ -5,8 +5,8 @@ pixels show. A weave repeats every texel or two, so it puts more energy in the f
 lightness detail (Gaussian scales 0-0.7 px) than in the next one (0.7-1.5 px); grain, mottle,
 veins and flat paint do not. Velvet's pile hides its weave, so in pixels it is smooth.
 
-Pixels: the central three quarters of each chosen view's crop, where the colour (CIELAB chroma, half
-of the lightness) is within ``color_tolerance`` of the object's dominant observed colour, away from
+Pixels: the central three quarters of each chosen view's crop, where the colour (CIELAB chroma and
+lightness) is within ``color_tolerance`` of the object's median observed colour, away from
 strong edges (the borders between faces and parts). Each view gives the RMS of the two bands over
 those pixels; the object's value is the median over views. With too few pixels, or a ratio between
 the two thresholds, nothing is said. The thresholds are measured by
@@ -34,9 +34,12 @@ SMOOTH_MATERIALS = frozenset({"leather", "velvet", "metal", "glass", "marble", "
 @dataclass(frozen=True)
 class SurfaceConfig:
     max_views: int = 5
-    color_tolerance: float = 12.0  # chroma distance + half the lightness difference, CIELAB units
+    color_tolerance: float = 12.0  # chroma distance + lightness_weight * lightness difference (CIELAB)
+    #: 0.5 let grey carpet and tiles into grey objects' pixels (3 of 26 woven calls wrong on seeds 1-9)
+    lightness_weight: float = 1.0
     edge_gradient: float = 4.0  # L* per pixel (Gaussian sigma 1) above which a pixel is an edge
     min_pixels: int = 150  # surface pixels over all views below which nothing is said
+    margin: float = 0.125  # share of the crop's height and width left out on each side
     #: Finest / next band RMS at or above which the surface is woven, and at or below which it is
     #: smooth (benchmarks/measure_evidence.py: share of each true material called woven / smooth).
     woven_ratio: float = 1.4
@@ -71,10 +74,11 @@ def _bands(lab: NDArray[np.float64], ref: NDArray[np.float64], cfg: SurfaceConfi
 
     h, w = lab.shape[:2]
     L = lab[..., 0]
-    dist = np.hypot(lab[..., 1] - ref[1], lab[..., 2] - ref[2]) + 0.5 * np.abs(L - ref[0])
+    dist = np.hypot(lab[..., 1] - ref[1], lab[..., 2] - ref[2]) + cfg.lightness_weight * np.abs(L - ref[0])
     mask = dist < cfg.color_tolerance
     central = np.zeros_like(mask)
-    central[h // 8: h - h // 8, w // 8: w - w // 8] = True
+    mh, mw = int(h * cfg.margin), int(w * cfg.margin)
+    central[mh: h - mh, mw: w - mw] = True
     edges = ndi.gaussian_gradient_magnitude(L, 1.0) > cfg.edge_gradient
     mask &= central & ~ndi.binary_dilation(edges, iterations=2)
     mask = ndi.binary_erosion(mask, iterations=2)

@@ -217,7 +217,9 @@ class OfflineVerifier(Verifier):
 
     def material(self, q: ParsedQuery, obj: MapObject) -> tuple[float | None, str]:
         """(agreement in [0, 1], why) of the spoken materials with the surface the pixels showed:
-        1 agrees, 0.5 says nothing about a weave or nothing was seen; None contradicts."""
+        1 a weave seen for a woven material, 0.5 not contradicted (a smooth surface is what every
+        material without a weave shows, so it is no evidence for leather over velvet or marble
+        over ceramic), None contradicted."""
         if not q.materials:
             return 0.0, ""
         surf = self.surface(obj)
@@ -227,7 +229,7 @@ class OfflineVerifier(Verifier):
             if c:
                 return None, (f"'{m}' but its pixels show a {surf.word} surface (finest/next band "
                               f"{surf.ratio:.2f})")
-            vals.append(0.5 if c is None else 1.0)
+            vals.append(1.0 if c is False and surf.word == "woven" else 0.5)
         return float(np.mean(vals)), f"material {'/'.join(q.materials)} vs {surf.word or 'no clear'} surface"
 
     def _name_sim(self, noun: str, name: str) -> float:
