@@ -35,7 +35,8 @@ SMOOTH_MATERIALS = frozenset({"leather", "velvet", "metal", "glass", "marble", "
 class SurfaceConfig:
     max_views: int = 5
     color_tolerance: float = 12.0  # chroma distance + lightness_weight * lightness difference (CIELAB)
-    #: 0.5 let grey carpet and tiles into grey objects' pixels (3 of 26 woven calls wrong on seeds 1-9)
+    #: Half the weight let grey carpet and tiles into grey objects' pixels (a weave was then seen
+    #: on grey leather and metal during development).
     lightness_weight: float = 1.0
     edge_gradient: float = 4.0  # L* per pixel (Gaussian sigma 1) above which a pixel is an edge
     min_pixels: int = 150  # surface pixels over all views below which nothing is said
