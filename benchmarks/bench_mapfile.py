@@ -114,6 +114,22 @@ def query_process(mp: Path, repeat: int) -> None:
             res = json.loads(out.stdout)
             ans = f"{res['chosen']['label']} {res['chosen']['id']}" if res.get("found") else "not found"
             print(f"| {name} | {text} | {ans} | {min(walls):.2f} s | {min(cpus):.2f} s | {min(cpus) / 1.0:.2f}x |")
+    # The same on the Python API, as a robot's task process would open the map and ask once.
+    api = ("import sys; from capnav.api import CapNav; "
+           "a = CapNav.open(sys.argv[1]).ask(sys.argv[2]); "
+           "print(f'{a.object.category} {a.object.id}' if a.found else 'not found')")
+    for text in QUERIES:
+        walls, cpus = [], []
+        for _ in range(repeat):
+            r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            t0 = time.perf_counter()
+            out = subprocess.run([sys.executable, "-c", api, str(mp), text], capture_output=True, text=True,
+                                 check=True)
+            walls.append(time.perf_counter() - t0)
+            r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpus.append(r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
+        print(f"| Python API: CapNav.open(map).ask(text) | {text} | {out.stdout.strip()} | {min(walls):.2f} s "
+              f"| {min(cpus):.2f} s | {min(cpus) / 1.0:.2f}x |")
     runs = []
     for _ in range(repeat):
         out = subprocess.run([sys.executable, __file__, "--phases", str(mp), QUERIES[0], str(time.time())],
