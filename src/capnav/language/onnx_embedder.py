@@ -21,7 +21,6 @@ from numpy.typing import NDArray
 
 from capnav.core.checksum import sha256_file
 from capnav.core.errors import ModelError
-from capnav.language import onnx_cache
 from capnav.language.embedder import EMBEDDERS, TextEmbedder
 
 MINILM_MODEL_SHA256 = "8199be6f699a395f99f89df973f9dc5285fbcfcdb2ae1a4e1201dab014f3d2a6"
@@ -66,15 +65,12 @@ class OnnxTextEmbedder(TextEmbedder):
         self._tok.no_padding()
         self._tok.enable_truncation(max_length=int(max_length))
         self._pad_id = 0 if pad_id is None else int(pad_id)
-        def options() -> Any:
-            opts = ort.SessionOptions()
-            if threads is not None:
-                opts.intra_op_num_threads = int(threads)
-                opts.inter_op_num_threads = 1
-            return opts
-
+        opts = ort.SessionOptions()
+        if threads is not None:
+            opts.intra_op_num_threads = int(threads)
+            opts.inter_op_num_threads = 1
         try:
-            self._sess = onnx_cache.session(model_path, digest, options)
+            self._sess = ort.InferenceSession(str(model_path), sess_options=opts, providers=["CPUExecutionProvider"])
         except Exception as e:
             raise ModelError(f"onnxruntime cannot load {model_path}: {e}") from None
         self._inputs = [i.name for i in self._sess.get_inputs()]
