@@ -116,7 +116,7 @@ def query_process(mp: Path, repeat: int) -> None:
             print(f"| {name} | {text} | {ans} | {min(walls):.2f} s | {min(cpus):.2f} s | {min(cpus) / 1.0:.2f}x |")
     # The same on the Python API, as a robot's task process would open the map and ask once.
     api = ("import sys; from capnav.api import CapNav; "
-           "a = CapNav.open(sys.argv[1]).ask(sys.argv[2]); "
+           "a = CapNav.open(sys.argv[1], voxels=False).ask(sys.argv[2]); "
            "print(f'{a.object.category} {a.object.id}' if a.found else 'not found')")
     for text in QUERIES:
         walls, cpus = [], []
@@ -128,7 +128,8 @@ def query_process(mp: Path, repeat: int) -> None:
             walls.append(time.perf_counter() - t0)
             r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
             cpus.append(r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
-        print(f"| Python API: CapNav.open(map).ask(text) | {text} | {out.stdout.strip()} | {min(walls):.2f} s "
+        print(f"| Python API: CapNav.open(map, voxels=False).ask(text) | {text} | {out.stdout.strip()} "
+              f"| {min(walls):.2f} s "
               f"| {min(cpus):.2f} s | {min(cpus) / 1.0:.2f}x |")
     runs = []
     for _ in range(repeat):

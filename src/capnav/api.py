@@ -181,14 +181,21 @@ class CapNav:
         self._costmap: Costmap | None = None
         self._grid: tuple[OccupancyGrid, list[str]] | None = None
         self._frames: Any = None  # the frames a map was built from (for captioning views)
+        self._without_voxels = False  # opened with voxels=False: save would lose them
 
     # -- opening, building, saving ----------------------------------------------------------------
     @classmethod
-    def open(cls, path: str | Path, **kwargs: Any) -> CapNav:
-        """Load a map file (``capnav map`` / ``save``); checks its format and checksums."""
+    def open(cls, path: str | Path, *, voxels: bool = True, **kwargs: Any) -> CapNav:
+        """Load a map file (``capnav map`` / ``save``); checks its format and checksums.
+
+        ``voxels=False`` skips the dense voxel map, most of the file and of the load time (asking
+        and planning never read it; 3D views and map pictures do): a robot process that opens a
+        map to ask once starts in about half the time. Such a map cannot be saved over a full one."""
         from capnav.io.mapfile import load_map
 
-        return cls(load_map(path), source=path, **kwargs)
+        nav = cls(load_map(path, voxels=voxels), source=path, **kwargs)
+        nav._without_voxels = not voxels
+        return nav
 
     @classmethod
     def build(cls, frames: Iterable[Frame], detector: str = "sim", *, detector_options: dict[str, Any] | None = None,
@@ -266,6 +273,9 @@ class CapNav:
         """Write the map file atomically (captions and caches included)."""
         from capnav.io.mapfile import save_map
 
+        if self._without_voxels:
+            raise InputError(f"this map was opened with voxels=False ({self.source}); saving it would drop its "
+                             "voxel map: open it with CapNav.open(path) to save")
         return save_map(self.map, path)
 
     # -- reading ------------------------------------------------------------------------------

@@ -135,3 +135,17 @@ def test_plans_like_navigate_from_the_camera_path(map_file: Path) -> None:
     assert not blind.plan((6.0, 3.0), 1).success
     with pytest.raises(InputError, match="records no camera path"):
         blind.plan(None, 1)
+
+
+def test_open_without_voxels_answers_alike_and_refuses_to_save(map_file: Path, tmp_path: Path) -> None:
+    """The fast path for a process that asks once: same answers and goals, no voxel map to lose."""
+    full, light = CapNav.open(map_file), CapNav.open(map_file, voxels=False)
+    assert len(light.map.voxels) == 0
+    for text in ("the red sofa", "the closest chair", "the piano"):
+        a, b = full.ask(text, robot=(6.0, 3.0)).to_dict(), light.ask(text, robot=(6.0, 3.0)).to_dict()
+        a.pop("timings_ms"), b.pop("timings_ms")
+        assert a == b
+    with pytest.raises(InputError, match="voxels=False"):
+        light.save(tmp_path / "copy.capnav")
+    assert not (tmp_path / "copy.capnav").exists()
+    assert full.save(tmp_path / "copy.capnav").is_file()
