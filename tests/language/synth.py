@@ -9,6 +9,7 @@ import numpy as np
 from capnav.core.frame import Frame
 from capnav.core.geometry import Intrinsics, look_at_pose
 from capnav.core.grid import FREE, OCCUPIED, UNKNOWN, GridSpec, OccupancyGrid
+from capnav.language.embedder import TextEmbedder
 from capnav.mapping.cmap import CameraTrajectory, CapNavMap
 from capnav.mapping.objects import MapObject, Observation
 from capnav.mapping.voxel_map import VoxelMap
@@ -103,6 +104,21 @@ class SquareReader:
             out.append(Observation(i, b, int((b[2] - b[0]) * (b[3] - b[1])), 0.9, "sofa", 2.0,
                                    truncated=b[0] <= 0 or b[2] >= 159, visibility=1.0))
         return out
+
+
+def captioned_map(objects: list[MapObject], emb: TextEmbedder, occupancy: OccupancyGrid | None = None) -> CapNavMap:
+    """``objects`` captioned by the offline captioner (rooms and walls from ``occupancy``) and
+    embedded with ``emb``, as a map: what retrieval tests ask."""
+    from capnav.language import create_captioner
+    from capnav.language.context import SceneContext
+
+    scene = SceneContext(objects, occupancy) if occupancy is not None else SceneContext(objects)
+    cap = create_captioner("offline")
+    texts = [cap.caption(o, scene).text for o in objects]
+    for o, text, v in zip(objects, texts, emb.embed(texts), strict=True):
+        o.caption = text
+        o.embedding, o.embedding_model = v, emb.model_id
+    return make_map(objects, occupancy)
 
 
 def described_living_map(folder: Path) -> Path:

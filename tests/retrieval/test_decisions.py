@@ -13,9 +13,9 @@ import json
 
 import pytest
 
-from capnav.language import SceneContext, create_captioner, create_embedder
+from capnav.language import SceneContext, create_embedder
 from capnav.retrieval import Retriever, parse_instruction
-from language.synth import grid_with_wall, make_map, make_obj
+from language.synth import captioned_map, grid_with_wall, make_obj
 
 
 @pytest.fixture(scope="module")
@@ -49,13 +49,7 @@ def flat() -> list:
 def retriever(emb):
     objs = flat()
     grid = grid_with_wall(-0.5, -0.5, 13.5, 6.5, wall_x=6.0, door=(2.5, 3.5))
-    scene = SceneContext(objs, grid)
-    cap = create_captioner("offline")
-    for o in objs:
-        o.caption = cap.caption(o, scene).text
-    for o, v in zip(objs, emb.embed([o.caption for o in objs]), strict=True):
-        o.embedding, o.embedding_model = v, emb.model_id
-    return Retriever(make_map(objs, grid), emb)
+    return Retriever(captioned_map(objs, emb, grid), emb)
 
 
 def ask(r, text, robot=None, **fields):
@@ -202,12 +196,7 @@ def test_a_hallway_is_the_region_where_no_rooms_objects_stand(emb):
     grid = grid_with_wall(-0.5, -0.5, 9.5, 4.0, wall_x=5.0, door=(1.0, 2.0))
     scene = SceneContext(objs, grid)
     assert scene.rooms[2] == "bedroom" and scene.rooms[3] is None  # lamps 3 and 4
-    cap = create_captioner("offline")
-    for o in objs:
-        o.caption = cap.caption(o, scene).text
-    for o, v in zip(objs, emb.embed([o.caption for o in objs]), strict=True):
-        o.embedding, o.embedding_model = v, emb.model_id
-    r = Retriever(make_map(objs, grid), emb)
+    r = Retriever(captioned_map(objs, emb, grid), emb)
     for text in ("the lamp in the hallway", "the hall lamp", "take me to the lamp in the corridor"):
         res = r.query(text)
         assert res.found and res.chosen.id == 4, text

@@ -8,10 +8,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from capnav.language import SceneContext, create_captioner, create_embedder
+from capnav.language import create_embedder
 from capnav.retrieval import Retriever
 from capnav.retrieval.spatial import end_distance, has_long_axis, oriented_box, segment_distance
-from language.synth import grid_with_wall, make_map, make_obj
+from language.synth import captioned_map, grid_with_wall, make_obj
 
 
 def test_oriented_box_finds_the_long_axis_of_a_rotated_footprint():
@@ -59,13 +59,7 @@ def retriever():
         make_obj(17, "lamp", (0.4, 0.3), (0.7, 0.7, 1.9), (235, 225, 200)),  # a big cream lamp far away
     ]
     grid = grid_with_wall(-0.5, -0.5, 11.5, 6.5, wall_x=5.0, door=(2.5, 3.5))
-    scene = SceneContext(objs, grid)
-    cap = create_captioner("offline")
-    for o in objs:
-        o.caption = cap.caption(o, scene).text
-    for o, v in zip(objs, emb.embed([o.caption for o in objs]), strict=True):
-        o.embedding, o.embedding_model = v, emb.model_id
-    return Retriever(make_map(objs, grid), emb)
+    return Retriever(captioned_map(objs, emb, grid), emb)
 
 
 def test_the_chair_at_the_end_of_the_table_sits_beyond_a_short_edge(retriever):

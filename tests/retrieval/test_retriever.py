@@ -11,7 +11,7 @@ from capnav.language.prompts import parse_verdict
 from capnav.retrieval import RetrievalConfig, Retriever, create_verifier, parse_instruction
 from capnav.retrieval.ranking import cosine_scores, mmr, top_k
 from capnav.retrieval.verifier import Candidate, VLMVerifier
-from language.synth import living_scene, make_map
+from language.synth import captioned_map, living_scene, make_map
 
 
 @pytest.fixture(scope="module")
@@ -21,15 +21,7 @@ def emb():
 
 @pytest.fixture()
 def cmap(emb):
-    objs = living_scene()
-    scene = SceneContext(objs)
-    cap = create_captioner("offline")
-    for o in objs:
-        o.caption = cap.caption(o, scene).text
-    vecs = emb.embed([o.caption for o in objs])
-    for o, v in zip(objs, vecs, strict=True):
-        o.embedding, o.embedding_model = v, emb.model_id
-    return make_map(objs)
+    return captioned_map(living_scene(), emb)
 
 
 def test_attribute_superlative_relation_room(cmap, emb):
