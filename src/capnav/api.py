@@ -22,7 +22,7 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -30,17 +30,19 @@ from numpy.typing import NDArray
 from capnav.core.errors import InputError, NotFoundError
 from capnav.core.frame import Frame
 from capnav.core.grid import OccupancyGrid
-from capnav.language.describe import DescribeReport
 from capnav.language.embedder import TextEmbedder
 from capnav.mapping.cmap import CapNavMap
-from capnav.mapping.mapper import MapperConfig
 from capnav.mapping.objects import MapObject
 from capnav.planning.config import PlannerConfig
-from capnav.planning.costmap import Costmap
-from capnav.planning.goal import GoalPose
 from capnav.retrieval.config import RetrievalConfig
 from capnav.retrieval.result import QueryResult
 from capnav.retrieval.retriever import Retriever
+
+if TYPE_CHECKING:  # the mapping and captioning stages (detectors, scipy) load only when a map is built
+    from capnav.language.describe import DescribeReport
+    from capnav.mapping.mapper import MapperConfig
+    from capnav.planning.costmap import Costmap
+    from capnav.planning.goal import GoalPose
 
 __all__ = ["Answer", "CapNav", "ObjectRecord", "Plan"]
 
