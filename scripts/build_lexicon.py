@@ -42,8 +42,10 @@ is spoken to):
   other's (an armchair is a chair; a coffee table, a desk, a nightstand and a counter are tables)
   and the Wu-Palmer similarity of their first synsets (chair-stool 0.9, chair-sofa 0.87): the
   parser turns these into weighted alternative categories.
-- ``glosses``: WordNet's definitions and examples of each category's synsets and their direct
-  hyponyms, for requests by purpose ("somewhere to sit" is matched to them with the text embedder).
+- ``glosses``: WordNet's definitions of each category's synsets and their direct hyponyms, for
+  requests by purpose ("somewhere to sit" is matched to them with the text embedder). Not its
+  example sentences: "he sat on the edge of the bed" says how the word is used, not what a bed is
+  for, and it drew "somewhere to lie down" to whatever else mentions sitting.
 - ``sizes``: size adjectives -> "large" / "small" ("king-size", "oversized", "tiny", "bigger",
   "tinier"): the lemmas of WordNet's adjective clusters around ``large.a.01`` and ``small.a.01``
   whose most frequent adjective sense lies in the cluster ("deep", "wide", "slim" and "super" are
@@ -273,8 +275,7 @@ def _build(wn: Any) -> dict[str, Any]:
         texts: list[str] = []
         for n in roots:
             s = wn.synset(n.rstrip("!"))
-            for t in (s.definition(), *s.examples()):
-                texts.append(t)
+            texts.append(s.definition())
             for h in sorted(s.hyponyms(), key=lambda x: x.name()):
                 if h.name() in owner and owner[h.name()] == cat:
                     texts.append(h.definition())

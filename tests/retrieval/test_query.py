@@ -3,6 +3,7 @@ from __future__ import annotations
 import pytest
 
 from capnav.core.errors import InputError
+from capnav.language.purpose import normalise_activity
 from capnav.retrieval import parse_instruction, validate_instruction
 
 
@@ -215,6 +216,24 @@ def test_requests_by_purpose(text, cats, emb):
     assert q.purpose and q.category in cats, q.to_dict()
     assert all(0 < w < 1 for w in q.category_alternatives.values())
     assert parse_instruction(text).category is None  # without an embedder: the purpose, no category
+
+
+@pytest.mark.parametrize(("activity", "said"), [
+    ("take a quick nap", "nap"), ("have a proper soak", "soak"), ("grab a cold drink", "cold drink"),
+    ("put my legs up", "put your legs up"), ("we could wash ourselves", "you could wash yourselves"),
+    ("do the dishes", "do the dishes"), ("have a", "have a"),  # no noun after the light verb: kept
+])
+def test_an_activity_is_put_the_way_the_glosses_speak(activity, said):
+    assert normalise_activity(activity) == said
+
+
+@pytest.mark.parametrize(("text", "cats"), [
+    ("where could we have a nap", {"bed", "sofa"}), ("where can I take a quick shower", {"bathtub"}),
+    ("where can I grab a cold drink", {"refrigerator"}),
+])
+def test_a_light_verb_does_not_hide_the_activity(text, cats, emb):
+    q = parse_instruction(text, emb)
+    assert q.category in cats, q.to_dict()
 
 
 @pytest.mark.parametrize(("text", "cat"), [

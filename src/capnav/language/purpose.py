@@ -6,6 +6,13 @@ place to sleep", a washbasin is "where you can wash your hands and face"), so no
 activities to objects. The best category becomes the target; close runners-up become weighted
 alternatives (a place to sit: chair, then armchair, sofa, stool).
 
+The activity is put the way the glosses speak before it is embedded: a light verb and its article
+go ("have a lie down" -> "lie down", "take a nap" -> "nap": the noun carries the meaning) and the
+speaker's pronouns become the generic "you" of the template ("put my feet up" -> "put your feet
+up"). A category scores the mean of its ``top_k`` best gloss cosines, not its single best: one
+hyponym's gloss that shares a word with the activity (a foot bath's "feet") no longer outranks a
+category whose definitions all fit.
+
 Embedding the ~100 glosses takes about 1 s, so ``describe_map`` stores them in the map
 (``cmap.caches["glosses"]``: the vectors with the embedder's ``model_id`` and a digest of the gloss
 texts) and the retriever hands them to ``use_stored_glosses``. They are used only when the query
@@ -39,15 +46,39 @@ _PURPOSE = [
                r"|get to\b|visit\b).+)"),
     re.compile(r"\b(?:i'm|i am|we're|we are)\s+(?P<act>(?:tired|sleepy|hungry|thirsty|cold|dirty)\b.*)"),
 ]
+#: A light verb with its article ("have a", "take a quick"): the noun after it names the activity.
+_LIGHT_VERB = re.compile(r"^(?:have|take|get|grab|catch|go\s+for|do)\s+(?:a|an|some)\s+"
+                         r"(?:(?:quick|little|short|long|good|proper|nice)\s+)?(?=\w)")
+#: First-person words -> the template's generic "you".
+_PERSON = {"my": "your", "me": "you", "myself": "yourself", "i": "you", "our": "your", "us": "you",
+           "ourselves": "yourselves", "we": "you", "mine": "yours"}
 #: Words after the activity that belong to the rest of the description, not to the activity.
 _TAIL = re.compile(r"\b(?:in|inside|near|next to|by|beside|close to|closest|nearest|farthest|furthest)\b.*$")
 _PLACEHOLDERS = {"somewhere", "someplace", "anywhere", "place", "spot", "something", "thing", "where"}
 
 
 @dataclass(frozen=True)
+class PurposeConfig:
+    template: str = "a place where you can {activity}"  # how the activity is embedded
+    top_k: int = 2  # a category's score: the mean of its top_k gloss cosines
+    margin: float = 0.08  # runners-up within this of the best score become alternatives
+    min_score: float = 0.2  # below this best score no category serves the activity
+    max_alternatives: int = 4
+
+
+@dataclass(frozen=True)
 class PurposeMatch:
     activity: str  # "wash my hands"
-    scores: dict[str, float]  # category -> cosine of the activity to its best gloss, best first
+    scores: dict[str, float]  # category -> mean cosine of the activity to its top_k glosses, best first
+
+
+def normalise_activity(activity: str) -> str:
+    """The activity as the template and the glosses say it: without a light verb ("have a lie
+    down" -> "lie down") and with "you" for the speaker ("put my feet up" -> "put your feet up")."""
+    act = " ".join(activity.lower().split())
+    stripped = _LIGHT_VERB.sub("", act)
+    act = stripped if stripped.strip() else act
+    return " ".join(_PERSON.get(w, w) for w in act.split())
 
 
 def find_activity(text: str) -> str | None:
@@ -96,13 +127,16 @@ class GlossIndex:
         return {"model": self.embedder.model_id, "digest": self.digest, "shape": list(self.E.shape),
                 "float32_le": base64.b64encode(np.ascontiguousarray(self.E, dtype="<f4").tobytes()).decode("ascii")}
 
-    def scores(self, activity: str) -> dict[str, float]:
-        q = self.embedder.embed([f"a place where you can {activity}"])[0]
+    def scores(self, activity: str, config: PurposeConfig | None = None) -> dict[str, float]:
+        """Category -> mean cosine of the (normalised) activity to its ``top_k`` best glosses."""
+        cfg = config or PurposeConfig()
+        q = self.embedder.embed([cfg.template.format(activity=normalise_activity(activity))])[0]
         sims = self.E @ q
-        best: dict[str, float] = {}
+        per: dict[str, list[float]] = {}
         for cat, s in zip(self.cats, sims, strict=True):
-            best[cat] = max(best.get(cat, -1.0), float(s))
-        return dict(sorted(best.items(), key=lambda kv: -kv[1]))
+            per.setdefault(cat, []).append(float(s))
+        out = {c: float(np.mean(sorted(v, reverse=True)[: max(1, cfg.top_k)])) for c, v in per.items()}
+        return dict(sorted(out.items(), key=lambda kv: -kv[1]))
 
 
 def _decode(stored: dict[str, Any], digest: str, shape: tuple[int, int]) -> NDArray[np.float32] | None:
@@ -139,25 +173,25 @@ def gloss_index(embedder: TextEmbedder) -> GlossIndex:
     return _INDEXES[key]
 
 
-def match_purpose(activity: str, embedder: TextEmbedder) -> PurposeMatch:
-    return PurposeMatch(activity, gloss_index(embedder).scores(activity))
+def match_purpose(activity: str, embedder: TextEmbedder, config: PurposeConfig | None = None) -> PurposeMatch:
+    return PurposeMatch(activity, gloss_index(embedder).scores(activity, config))
 
 
-def purpose_categories(match: PurposeMatch, margin: float = 0.08, min_score: float = 0.2,
-                       max_alternatives: int = 4) -> tuple[str | None, dict[str, float]]:
+def purpose_categories(match: PurposeMatch, config: PurposeConfig | None = None) -> tuple[str | None, dict[str, float]]:
     """(best category, alternatives with weights < 1): categories within ``margin`` of the best
-    cosine, weighted by their cosine relative to the best."""
+    score, weighted by their score relative to the best."""
+    cfg = config or PurposeConfig()
     items = list(match.scores.items())
-    if not items or items[0][1] < min_score:
+    if not items or items[0][1] < cfg.min_score:
         return None, {}
     best_cat, best = items[0]
     alts: dict[str, float] = {}
     for cat, s in items[1:]:
-        if s < best - margin or len(alts) >= max_alternatives:
+        if s < best - cfg.margin or len(alts) >= cfg.max_alternatives:
             break
         alts[cat] = round(min(0.95, 0.95 * s / best), 3)
     return best_cat, alts
 
 
-__all__ = ["CACHE_KEY", "GlossIndex", "PurposeMatch", "find_activity", "gloss_index", "match_purpose",
-           "purpose_categories", "use_stored_glosses"]
+__all__ = ["CACHE_KEY", "GlossIndex", "PurposeConfig", "PurposeMatch", "find_activity", "gloss_index",
+           "match_purpose", "normalise_activity", "purpose_categories", "use_stored_glosses"]
