@@ -56,7 +56,7 @@ def true_shape(category: str, variant: str) -> tuple[str, str] | None:
     if category in _ROUNDABLE:
         return ("round", "rectangular") if variant == "round" else ("rectangular", "round")
     if category == "plant":
-        return ("slender", "bushy") if variant == "cactus" else ("bushy", "slender")
+        return ("slender", "leafy") if variant == "cactus" else ("leafy", "slender")
     return None
 
 

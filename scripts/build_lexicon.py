@@ -52,6 +52,14 @@ is spoken to):
   another sense first) and which are not used more often as a noun or verb in WordNet's
   sense-tagged corpus ("minute", "giant"), with their comparatives from WordNet's exception list
   (``adj.exc``: bigger, tinier); a hyphenated one also with a space ("king size").
+- ``growth``: words that name a plant's growth form -> the growth word the captioner measures
+  from the points (``capnav.language.form.growth``). A cactus grows as a column narrower than its
+  pot, so every lemma of ``cactus.n.01`` and its hyponyms, and of ``succulent.n.01`` itself (the
+  class WordNet files cacti under), implies "slender"; the succulent's other hyponyms (aloe,
+  living stones) are rosettes and imply nothing. So do the adjectives WordNet derives from the
+  plant parts that the cactus's definition names ("usually having spines": spine -> spiny,
+  prickly, thorny, spinous, with their synsets' other lemmas), except parts that are the cactus's
+  own hypernyms or taxonomic groups ("succulent", "Cactaceae").
 - ``foreign``: function words of French, Spanish, German, Italian, Portuguese and Dutch (from the
   ``stop-words`` package) that are not English: not an English stop word (scikit-learn's list) and
   not a WordNet lemma
@@ -159,6 +167,8 @@ def build(wordnet: Path) -> dict[str, Any]:
         wn = open_wordnet(wordnet, Path(tmp))
         out = _build(wn)
         out["sizes"] = _sizes(wn, (wordnet / "adj.exc").read_text().splitlines())
+        out["growth"] = _growth(wn, out["forms"])
+        out["forms"] = dict(sorted(out["forms"].items()))
         return out
 
 
@@ -191,6 +201,45 @@ def _sizes(wn: Any, exceptions: list[str]) -> dict[str, str]:
         infl, *bases = line.split()
         if not infl.endswith("est") and any(b in out for b in bases):
             out.setdefault(infl, out[next(b for b in bases if b in out)])
+    return dict(sorted(out.items()))
+
+
+#: Growth forms: the synset whose lemmas (with its hyponyms') imply the growth word, the synsets
+#: whose own lemmas do too, and the word (``capnav.language.form.growth`` says it of the points).
+GROWTH_FORMS = {"slender": ("cactus.n.01", ["succulent.n.01"])}
+
+
+def _growth(wn: Any, forms: dict[str, str]) -> dict[str, str]:
+    """Words that imply a plant's growth form (see the module docstring). The lemmas of the
+    synsets named in ``GROWTH_FORMS`` become plant forms (in ``forms``) even when WordNet also has
+    them as an adjective, which keeps other words out of ``forms``: "succulent" names the plant."""
+    import re
+
+    out: dict[str, str] = {}
+    for word, (root, own) in GROWTH_FORMS.items():
+        syn = wn.synset(root)
+        for n in own:
+            for lem in wn.synset(n).lemmas():
+                if lem.name() == lem.name().lower():
+                    forms.setdefault(_form(lem.name()), "plant")
+        members = [syn, *syn.closure(lambda x: x.hyponyms()), *(wn.synset(n) for n in own)]
+        for s in members:
+            for lem in s.lemmas():
+                form = _form(lem.name())
+                if lem.name() == lem.name().lower() and forms.get(form) == "plant":
+                    out[form] = word
+        above = {h.name() for h in syn.closure(lambda x: x.hypernyms())}
+        for tok in re.findall(r"[a-z]+", syn.definition().lower()):
+            base = wn.morphy(tok, "n")
+            for part in wn.synsets(base, "n") if base else []:
+                if part.lexname() != "noun.plant" or part.name() in above or part.member_meronyms():
+                    continue
+                for lem in part.lemmas():
+                    for d in lem.derivationally_related_forms():
+                        if d.synset().pos() in "as":
+                            for adj in d.synset().lemmas():
+                                if adj.name().isalpha() and adj.name() == adj.name().lower():
+                                    out.setdefault(adj.name(), word)
     return dict(sorted(out.items()))
 
 

@@ -30,8 +30,8 @@ def test_outline_round_rectangular_long():
     assert outline(_board(1.0, 0.6)[:20]) is None  # too few points to say
 
 
-def test_a_plant_is_bushy_when_its_foliage_spreads_wider_than_its_pot_and_slender_when_narrower():
-    assert growth(plant_points((0, 0), 0.35)) == "bushy"
+def test_a_plant_is_leafy_when_its_foliage_spreads_wider_than_its_pot_and_slender_when_narrower():
+    assert growth(plant_points((0, 0), 0.35)) == "leafy"
     assert growth(plant_points((0, 0), 0.06)) == "slender"  # a columnar cactus
     assert growth(plant_points((0, 0), 0.14)) is None  # about the pot's width: nothing clear
 
@@ -73,7 +73,7 @@ def test_conflicts_are_only_the_measured_ones():
     assert material_conflict("fabric", None) is None and material_conflict("gold", "smooth") is None
     assert shape_conflict("round", ["rectangular"]) == "rectangular"
     assert shape_conflict("square", ["round"]) is None  # "round" was said of some square stools
-    assert shape_conflict("slender", ["bushy"]) == "bushy"
+    assert shape_conflict("slender", ["leafy"]) == "leafy"
 
 
 def test_the_caption_says_the_surface_and_shape_it_observed():
@@ -87,4 +87,4 @@ def test_the_caption_says_the_surface_and_shape_it_observed():
     texts = {o.id: cap.caption(o, scene).text for o in (table, sofa, plant)}
     assert "round table" in texts[1]
     assert "green fabric" in texts[2] and "sofa" in texts[2]
-    assert "bushy plant" in texts[3]
+    assert "leafy plant" in texts[3]

@@ -83,3 +83,16 @@ def test_size_adjectives_come_from_wordnet_s_size_clusters():
     # another sense first ("deep", "wide", "slim") or more often a noun ("minute", "giant")
     for w in ("deep", "wide", "slim", "minute", "giant", "super"):
         assert w not in sizes, w
+
+
+def test_cactus_words_imply_the_columnar_growth_form():
+    lex = load_lexicon()
+    # cacti and their hyponyms, the succulent itself, and the adjectives of the cactus's spines
+    for w in ("cactus", "saguaro", "prickly pear", "succulent", "spiny", "prickly", "thorny"):
+        assert lex.growth[w] == "slender", w
+    assert lex.forms["succulent"] == "plant"  # a noun although WordNet has the adjective first
+    # a succulent that grows as a rosette, the plant in general, and the cactus's own class words
+    for w in ("aloe", "plant", "fern", "juicy", "lush"):
+        assert w not in lex.growth, w
+    # a glossary entry is no definition: WordNet's example sentences are not kept as glosses
+    assert not any(g.startswith("he sat") for g in lex.glosses["bed"])

@@ -218,6 +218,17 @@ def test_requests_by_purpose(text, cats, emb):
     assert parse_instruction(text).category is None  # without an embedder: the purpose, no category
 
 
+@pytest.mark.parametrize(("text", "shapes", "size"), [
+    ("the prickly plant", ["slender"], None), ("the larger cactus in the study", ["slender"], "large"),
+    ("the succulent on the shelf", ["slender"], None), ("the bushy fern", ["leafy"], None),
+    ("the thorny armchair", [], None),  # a growth word says something of plants only
+])
+def test_plant_words_say_the_growth_form(text, shapes, size):
+    q = parse_instruction(text)
+    assert (q.shapes, q.size_word) == (shapes, size), q.to_dict()
+    assert q.category != "plant" or not {"prickly", "cactus", "succulent"} & set(q.unknown_words)
+
+
 @pytest.mark.parametrize(("activity", "said"), [
     ("take a quick nap", "nap"), ("have a proper soak", "soak"), ("grab a cold drink", "cold drink"),
     ("put my legs up", "put your legs up"), ("we could wash ourselves", "you could wash yourselves"),

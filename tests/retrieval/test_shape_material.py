@@ -58,7 +58,7 @@ def test_the_observed_words_reach_the_attribute_cache(emb):
     attrs = cmap.caches["attributes"]
     assert attrs["1"]["surface"][0] == "woven" and attrs["2"]["surface"][0] == "smooth"
     assert attrs["3"]["shapes"] == ["round"] and attrs["4"]["shapes"] == ["rectangular"]
-    assert "bushy" in attrs["5"]["shapes"] and "slender" in attrs["6"]["shapes"]
+    assert "leafy" in attrs["5"]["shapes"] and "slender" in attrs["6"]["shapes"]
 
 
 def test_material_agreement_chooses_between_lookalikes(emb):
@@ -91,4 +91,28 @@ def test_plant_growth_words(emb):
     assert r.query("the bushy plant").chosen.id == 5
     assert r.query("take me to the slender plant").chosen.id == 6
     res = retriever(emb, {1, 2, 3, 4, 5}).query("take me to the slender plant")
-    assert not res.found and "bushy" in res.reason
+    assert not res.found and "leafy" in res.reason
+
+
+def test_cactus_words_reach_the_columnar_growth_form(emb):
+    # WordNet: a cactus is a succulent "usually having spines"; the lexicon ties these words to the
+    # "slender" growth the points show (foliage narrower than the pot).
+    r = retriever(emb)
+    for text in ("go to the cactus", "the spiny plant please", "take me to the succulent", "the thorny houseplant"):
+        res = r.query(text)
+        assert res.chosen is not None and res.chosen.id == 6, (text, res.reason)
+    res = retriever(emb, {1, 2, 3, 4, 5}).query("go to the cactus")
+    assert not res.found and "leafy" in res.reason  # the only plant spreads wider than its pot
+
+
+def test_a_size_word_ranks_among_the_cacti(emb):
+    small = make_obj(7, "plant", (2.5, 2.5), (0.2, 0.2, 0.7), (50, 125, 45))
+    small.points = plant_points((2.5, 2.5), 0.05, seed=3)
+    small.points[:, 2] *= 0.7 / 1.1
+    cmap = make_map([*room({5, 6}), small])
+    describe_map(cmap, None, create_captioner("offline"), emb, progress=False)
+    r = Retriever(cmap, emb)
+    # The leafy plant is the biggest plant, but no cactus: "the larger cactus" is the larger of the two.
+    assert r.query("the larger cactus").chosen.id == 6
+    assert r.query("the smaller cactus").chosen.id == 7
+    assert r.query("the bigger plant").chosen.id == 5

@@ -1,7 +1,7 @@
 """Shape words from an object's fused points: its outline and a plant's growth; None when unsure.
 
-Why: people single objects out by shape ("the round table", "the L-shaped sofa", "the bushy
-plant"), and the map holds each object's points. Every rule here reads only those points
+Why: people single objects out by shape ("the round table", "the L-shaped sofa", "the leafy
+plant", "the cactus"), and the map holds each object's points. Every rule here reads only those points
 (world frame, z up); its thresholds are measured by ``benchmarks/measure_evidence.py`` against
 the simulator's shape variants and said in the README (issue 12). A word is said only when its
 measure is clearly on one side; a verifier refuses only a word that contradicts a said one.
@@ -30,8 +30,8 @@ CONFLICTS: dict[str, frozenset[str]] = {
     "square": frozenset({"long", "L-shaped"}),
     "long": frozenset({"round"}),
     "L-shaped": frozenset({"round"}),
-    "bushy": frozenset({"slender"}),
-    "slender": frozenset({"bushy"}),
+    "leafy": frozenset({"slender"}),
+    "slender": frozenset({"leafy"}),
 }
 
 
@@ -44,10 +44,11 @@ class FormConfig:
     l_shape_fill: float = 0.86  # occupied share of the footprint hull below which it is L-shaped
     l_shape_min_area: float = 1.5  # m² of hull: only sofa/counter-sized objects can be L-shaped
     long_aspect: float = 2.3
-    #: Plants: width of the upper 60% (foliage) over the lowest 20% (pot); bushy foliage spreads
+    #: Plants: width of the upper 60% (foliage) over the lowest 20% (pot); leafy foliage spreads
     #: wider than its pot, a columnar one (a cactus) stays narrower. Leafy crowns on a stem and
-    #: leafy bushes measure alike (1.13-1.72), so both are "bushy".
-    bushy_spread: float = 1.15
+    #: leafy bushes measure alike (1.20-1.63 on seeds 1-3), so both are "leafy", never "bushy": the
+    #: points do not tell a bush from a crown on a stem.
+    leafy_spread: float = 1.15
     slender_spread: float = 0.8
 
 
@@ -132,13 +133,13 @@ def foliage_spread(points: F64) -> float | None:
 
 
 def growth(points: F64, cfg: FormConfig | None = None) -> str | None:
-    """"bushy" (foliage wider than its pot) or "slender" (narrower: columnar, like a cactus)."""
+    """"leafy" (foliage wider than its pot) or "slender" (narrower: columnar, like a cactus)."""
     cfg = cfg or FormConfig()
     s = foliage_spread(points)
     if s is None:
         return None
-    if s >= cfg.bushy_spread:
-        return "bushy"
+    if s >= cfg.leafy_spread:
+        return "leafy"
     if s <= cfg.slender_spread:
         return "slender"
     return None

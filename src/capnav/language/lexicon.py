@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 from importlib import resources
 from typing import Any
@@ -38,6 +38,9 @@ class Lexicon:
     english: frozenset[str]  # English function words that no other of those languages uses
     not_typos: frozenset[str]  # common words that look like a category or colour word ("store")
     sizes: dict[str, str]  # size adjective ("king-size", "tinier") -> "large" / "small"
+    #: a word naming a plant's growth form ("cactus", "prickly") -> the growth word the captioner
+    #: measures from the points ("slender"; ``capnav.language.form.growth``)
+    growth: dict[str, str] = field(default_factory=dict)
     load_seconds: float = 0.0
 
     def category_alternatives(self, category: str, form: str | None = None) -> dict[str, float]:
@@ -70,7 +73,8 @@ def load_lexicon() -> Lexicon:
                   other=frozenset(raw.get("other", [])), relations=raw.get("relations", {}),
                   glosses={k: tuple(v) for k, v in raw.get("glosses", {}).items()},
                   foreign=frozenset(raw.get("foreign", [])), english=frozenset(raw.get("english", [])),
-                  not_typos=frozenset(raw.get("not_typos", [])), sizes=dict(raw.get("sizes", {})))
+                  not_typos=frozenset(raw.get("not_typos", [])), sizes=dict(raw.get("sizes", {})),
+                  growth=dict(raw.get("growth", {})))
     object.__setattr__(lex, "load_seconds", time.perf_counter() - t0)
     return lex
 

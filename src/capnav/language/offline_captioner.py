@@ -80,7 +80,7 @@ _GROWING = {"plant"}
 class ObservationCaptioner(Captioner):
     """Writes "NAME, one sentence" from the map's observations (no model, deterministic)."""
 
-    model_id = "offline-observation-v2"  # v2: surface, rectangular and growth words
+    model_id = "offline-observation-v3"  # v2: surface, rectangular and growth words; v3: "leafy", not "bushy"
 
     def __init__(self, config: OfflineCaptionConfig | None = None) -> None:
         self.config = config or OfflineCaptionConfig()

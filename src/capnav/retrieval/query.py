@@ -91,8 +91,13 @@ _SIZE_TOKENS = {w for f in _SIZE_WORDS for w in f.split()}
 _SHAPES = {"round": "round", "circular": "round", "l-shaped": "L-shaped", "l shaped": "L-shaped",
            "corner": "L-shaped", "long": "long", "rectangular": "rectangular", "square": "square",
            "curved": "curved", "oval": "round",
-           # the growth words the offline captioner says of a plant (capnav.language.form)
-           "bushy": "bushy", "slender": "slender"}
+           # the growth words the offline captioner says of a plant (capnav.language.form): a bush
+           # is leafy (its points do not tell it from a leafy crown on a stem)
+           "leafy": "leafy", "bushy": "leafy", "slender": "slender"}
+#: Words that name a plant's growth form ("cactus", "succulent", "prickly"; WordNet's, the lexicon)
+#: -> the growth word the captioner measures ("slender").
+_GROWTH = _LEX.growth
+_GROWTH_TOKENS = {w for f in _GROWTH for w in f.split()}
 #: Relations whose geometry the retriever measures beyond the gap: "between" two landmarks
 #: (``anchor2_category``), "at the end of" a long object (the ends of its long axis), and
 #: "in the room with" a landmark (its room region).
@@ -545,8 +550,13 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> Parsed
         # "pool table", "power plant": WordNet names another object ending in a category word.
         cat, span = None, None
     q.category = cat
+    if cat == "plant":
+        # "the cactus", "the prickly plant": the growth form the word implies, checked against the points.
+        grams = {" ".join(words[i:i + n]) for n in (1, 2, 3) for i in range(len(words) - n + 1)}
+        q.shapes = list(dict.fromkeys([*q.shapes, *sorted({_GROWTH[g] for g in grams if g in _GROWTH})]))
     known = (set(_FILLER) | set(LEXICON) | set(ALIASES) | set(_SHAPES) | _SIZE_TOKENS | set(_SUPERLATIVE)
              | _MATERIALS | _COMMON_ADJECTIVES | {w for c in q.colors for w in c.split()}
+             | (_GROWTH_TOKENS if cat == "plant" else set())
              | {w for w in words if re.fullmatch(r"[a-z]+-colou?red", w)})
     if cat is not None and span is not None:
         form = " ".join(words[span[0]:span[1]])

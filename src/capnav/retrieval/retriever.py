@@ -179,8 +179,8 @@ class Retriever:
 
     def _anchors(self, q: ParsedQuery, notes: list[str], second: bool = False) -> NDArray[np.intp]:
         """The landmark's instances (the second landmark's of "between" with ``second``), resolved
-        first: of its category, and when its phrase says a colour or a room, only the instance(s)
-        that fit best ("the yellow lamp")."""
+        first: of its category, and when its phrase says a colour, a room or a shape, only the
+        instance(s) that fit best ("the yellow lamp", "the cactus")."""
         category, phrase = (q.anchor2_category, q.anchor2_phrase) if second else (q.anchor_category, q.anchor_phrase)
         assert category is not None
         anchors = self._of_category(category)
@@ -198,6 +198,12 @@ class Retriever:
         if aq.room is not None:
             inroom = anchors[[self.scene.rooms[k] == aq.room for k in anchors]]
             anchors = inroom if len(inroom) else anchors
+        if aq.shapes and len(anchors) > 1:
+            # "next to the cactus": the plants whose points show the cactus's growth form.
+            agree = np.array([self.judge.shape(aq, self.objects[k])[0] or 0.0 for k in anchors])
+            if agree.max() > 0:
+                anchors = anchors[agree >= agree.max()]
+                notes.append(f"landmark '{phrase}': object {', '.join(str(self.objects[k].id) for k in anchors)}")
         return anchors
 
     def _order(self, q: ParsedQuery, s: NDArray[np.float32], robot_xy: tuple[float, float] | None,
