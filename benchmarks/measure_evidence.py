@@ -4,12 +4,12 @@ Each threshold says when an observation disagrees with a spoken attribute. It is
 from how the map's observations of every instance compare with that instance's truth (the
 manifest: colour name, room, model size), never from instructions:
 
-* colour: the agreement (``OfflineVerifier.color``) of an object's observed colours with its true
-  colour word, against the agreement with colour words a person would not use for it (CIEDE2000
-  to the true word above ``--far``, and the true colour no shade of the word). ``color_reject``
-  keeps all but ``--miss`` of the true words;
-  ``color_match`` (negation: "not the white one") is reached by no more than ``--miss`` of the
-  wrong words.
+* colour: the plausibility (``OfflineVerifier.color_fit``: every shade the word covers counts) of
+  an object's observed colours for its true colour word, against the plausibility of colour words
+  a person would not use for it (CIEDE2000 to the true word above ``--far``, and the true colour
+  none of the shades the word covers, ``colors.family``). ``color_reject`` keeps all but
+  ``--miss`` of the true words; ``color_match`` (negation: "not the white one") is the ranking
+  agreement (``OfflineVerifier.color``) reached by no more than ``--miss`` of the wrong words.
 * size: mapped volume ratio of two objects of one truth model and size (should be 1); the ratio
   below which size words cannot rank two instances is its 95th percentile.
 * room: the inferred room against the room that holds the object's centre (inferred, unknown,
@@ -39,12 +39,12 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from capnav.language import SceneContext, create_embedder
-from capnav.language.colors import LEX_LAB, NAMES, canonical_color, ciede2000
+from capnav.language.colors import LEX_LAB, NAMES, canonical_color, ciede2000, family
 from capnav.language.context import label_of
 from capnav.language.form import shape_conflict
 from capnav.language.surface import WOVEN_MATERIALS, material_conflict
 from capnav.retrieval.query import ParsedQuery
-from capnav.retrieval.verifier import OfflineVerifier, OfflineVerifierConfig, shades
+from capnav.retrieval.verifier import OfflineVerifier, OfflineVerifierConfig
 from eval_retrieval import build, instance_of
 
 #: Shape words each (category, truth variant) deserves and the word that would be wrong for it.
@@ -128,6 +128,8 @@ def main() -> None:
     args.work.mkdir(parents=True, exist_ok=True)
     true_agree: list[float] = []
     wrong_agree: list[float] = []
+    wrong_rank: list[float] = []
+    true_rank: list[float] = []
     ratios: list[float] = []
     rooms: Counter[str] = Counter()
     room_rows = []
@@ -147,12 +149,17 @@ def main() -> None:
             word = canonical_color(truth.color_name)
             if word is not None:
                 text = "the plant in the pot" if truth.category == "plant" else "the object"
-                true_agree.append(judge.color(ParsedQuery(text=text, colors=[word]), o)[0])
+                rank, fit, _ = judge.color_fit(ParsedQuery(text=text, colors=[word]), o)
+                true_agree.append(fit)
+                true_rank.append(rank)
                 d = ciede2000(LEX_LAB[NAMES.index(word)][None], LEX_LAB, kL=2.0)
-                # A word is wrong when far from the true colour and not one of its shades (grey for
-                # a dark grey object: people say that).
-                for w in (NAMES[k] for k in np.flatnonzero(d > args.far) if word not in shades(NAMES[k])):
-                    wrong_agree.append(judge.color(ParsedQuery(text=text, colors=[w]), o)[0])
+                # A word is wrong when far from the true colour and the true colour is none of the
+                # shades it covers (grey for a dark grey object, yellow for a mustard one: people
+                # say that).
+                for w in (NAMES[k] for k in np.flatnonzero(d > args.far) if word not in family(NAMES[k])):
+                    rank, fit, _ = judge.color_fit(ParsedQuery(text=text, colors=[w]), o)
+                    wrong_agree.append(fit)
+                    wrong_rank.append(rank)
             form_rows.append((truth.category, truth.shape, truth.material, judge.shapes(o), judge.surface(o).word))
             said = scene.room_of(o)
             real = room_name[truth.room]
@@ -172,18 +179,18 @@ def main() -> None:
                     ratios.append(max(vols[i], vols[j]) / max(min(vols[i], vols[j]), 1e-9))
     ta, wa = np.array(true_agree), np.array(wrong_agree)
     reject = float(np.quantile(ta, args.miss))
-    match = float(np.quantile(wa, 1.0 - args.miss))
+    match = float(np.quantile(np.array(wrong_rank), 1.0 - args.miss))
     print(f"\nseeds {args.seeds}: {len(ta)} objects with a true colour word, {len(wa)} (object, wrong word) pairs")
     print("| measure | value |")
     print("|---|---:|")
-    print(f"| colour agreement, true word: p1 / p2 / p5 / median | {np.quantile(ta, 0.01):.3f} / "
+    print(f"| colour plausibility, true word: p1 / p2 / p5 / median | {np.quantile(ta, 0.01):.3f} / "
           f"{np.quantile(ta, 0.02):.3f} / {np.quantile(ta, 0.05):.3f} / {np.median(ta):.3f} |")
-    print(f"| colour agreement, wrong word: median / p95 / p98 / max | {np.median(wa):.3f} / "
+    print(f"| colour plausibility, wrong word: median / p95 / p98 / max | {np.median(wa):.3f} / "
           f"{np.quantile(wa, 0.95):.3f} / {np.quantile(wa, 0.98):.3f} / {wa.max():.3f} |")
     print(f"| color_reject (true words kept: {1 - args.miss:.0%}) | {reject:.3f} |")
     print(f"|   wrong words refused at color_reject | {np.mean(wa < reject):.1%} |")
     print(f"| color_match (wrong words reaching it: {args.miss:.0%}) | {match:.3f} |")
-    print(f"|   true words reaching color_match | {np.mean(ta >= match):.1%} |")
+    print(f"|   true words reaching color_match | {np.mean(np.array(true_rank) >= match):.1%} |")
     if ratios:
         r = np.array(ratios)
         print(f"| volume ratio of same-size instances: median / p95 / max ({len(r)} pairs) | "

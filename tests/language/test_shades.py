@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from capnav.core.errors import InputError
-from capnav.language.colors import LEX_LAB, NAMES, color_agreement, color_distance, color_lab
+from capnav.language.colors import LEX_LAB, NAMES, color_agreement, color_distance, color_lab, family
 
 
 def lab(name: str) -> np.ndarray:
@@ -41,3 +41,15 @@ def test_non_colours(phrase):
     assert color_lab(phrase) is None
     with pytest.raises(InputError):
         color_distance(phrase, (50.0, 0.0, 0.0))
+
+
+def test_a_basic_colour_word_covers_its_shades_only():
+    # Mustard is a yellow and walnut a brown; shades between two terms (indigo: purple or blue?)
+    # belong to neither, and pink is no purple.
+    assert "mustard" in family("yellow") and "walnut" in family("brown")
+    assert {"forest green", "olive green"} <= set(family("green"))
+    assert family("purple") == ("purple",)
+    assert "pink" not in family("purple") and "purple" not in family("pink")
+    assert family("gray") == family("grey") and family("grey")[0] == "grey"
+    # A word that is not a basic term covers itself only.
+    assert family("mustard") == ("mustard",) and family("pale pink") == ("pale pink",)

@@ -211,3 +211,41 @@ def test_a_hallway_is_the_region_where_no_rooms_objects_stand(emb):
         assert res.found and res.chosen.id == 4, text
         assert "hallway" in res.reason
     assert r.query("the lamp in the bedroom").chosen.id == 3
+
+
+def test_a_colour_word_accepts_the_shades_it_covers_and_refuses_the_others(emb):
+    # A mustard lamp and a dark green armchair, the colours a person calls "yellow" and "green",
+    # beside a pink armchair that no one calls purple.
+    objs = [make_obj(1, "lamp", (1.0, 1.0), (0.4, 0.4, 1.5), (200, 150, 30)),
+            make_obj(2, "armchair", (3.0, 1.0), (0.8, 0.8, 0.9), (46, 120, 60)),
+            make_obj(3, "armchair", (5.0, 1.0), (0.8, 0.8, 0.9), (225, 130, 160)),
+            make_obj(4, "sofa", (3.0, 3.0), (2.0, 0.9, 0.8), (128, 128, 128))]
+    r = Retriever(captioned_map(objs, emb, grid_with_wall(-0.5, -0.5, 6.5, 4.5)), emb)
+    res = r.query("could you take me to the yellow lamp")
+    assert res.found and res.chosen.id == 1 and "as mustard" in res.reason
+    res = r.query("the green armchair please")
+    assert res.found and res.chosen.id == 2
+    res = r.query("go to the purple armchair")
+    assert not res.found and "colour purple" in res.reason
+    # With a yellow lamp beside the mustard one, "yellow" ranks the yellow one first.
+    objs.append(make_obj(5, "lamp", (5.5, 3.5), (0.4, 0.4, 1.5), (250, 225, 30)))
+    r = Retriever(captioned_map(objs, emb, grid_with_wall(-0.5, -0.5, 6.5, 4.5)), emb)
+    assert r.query("could you take me to the yellow lamp").chosen.id == 5
+
+
+def test_a_room_refuses_only_where_its_evidence_is_confident(emb):
+    # Left of the wall a desk, a chair and a wardrobe (no bed): the desk types that room "office",
+    # but the wardrobe is a bedroom cue where the desk stands. Right of it a living room.
+    objs = [make_obj(1, "desk", (1.0, 0.5), (1.2, 0.6, 0.75), (120, 80, 40)),
+            make_obj(2, "chair", (1.0, 1.3), (0.5, 0.5, 0.9), (40, 40, 40)),
+            make_obj(3, "wardrobe", (3.5, 0.4), (1.4, 0.6, 2.0), (180, 140, 90)),
+            make_obj(4, "sofa", (8.0, 0.6), (2.0, 0.9, 0.8), (128, 128, 128)),
+            make_obj(5, "armchair", (8.0, 3.0), (0.8, 0.8, 0.9), (40, 70, 170))]
+    grid = grid_with_wall(-0.5, -0.5, 10.5, 4.0, wall_x=5.0, door=(1.5, 2.5))
+    r = Retriever(captioned_map(objs, emb, grid), emb)
+    assert r.scene.rooms[0] == "office"
+    res = r.query("take me to the desk in the bedroom")
+    assert res.found and res.chosen.id == 1 and "bedroom cues" in res.reason
+    # No bedroom cue stands where the sofa is: that refusal is confident.
+    res = r.query("the sofa in the bedroom")
+    assert not res.found and "no sofa stands in the bedroom" in res.reason

@@ -15,6 +15,7 @@ object captioned "light grey" by colour distance rather than by exact word.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
@@ -354,3 +355,55 @@ def color_agreement(word: str, lab: NDArray[np.floating] | tuple[float, float, f
                     kL: float = 2.0) -> float:
     """How well a colour word or phrase fits a measured colour, in (0, 1]: exp(-ΔE00 / scale)."""
     return float(np.exp(-color_distance(word, lab, kL=kL) / scale))
+
+
+# -- colour families: what a spoken word covers ---------------------------------------------------
+
+#: The basic colour terms of English (Berlin and Kay, 1969): the words people use for a whole
+#: range of shades that the palette names more finely ("mustard is a yellow").
+BASIC: tuple[str, ...] = ("white", "black", "grey", "red", "orange", "yellow", "green", "blue", "purple", "pink",
+                          "brown")
+#: ΔE00 (kL = 2) within which a named colour is a shade of its nearest basic term: the distance at
+#: which the verifier's agreement exp(-ΔE00 / 12) reaches its "is that colour" level (0.43, beside
+#: ``OfflineVerifierConfig.color_match``), so a basic term covers only colours it would match itself.
+FAMILY_RADIUS = 10.0
+#: A shade belongs to a basic term only when every other basic term is at least this many times
+#: farther: indigo (purple 8.6, blue 13.7) and silver (white 5.9, grey 7.5) lie between two terms
+#: and belong to neither; mustard (yellow 6.9, green 27.5) is a yellow.
+FAMILY_MARGIN = 2.0
+
+
+def _named_labs() -> dict[str, F64]:
+    """Every named colour (palette and shade words, aliases resolved) with its CIELAB point."""
+    out = {n: np.asarray(LEX_LAB[i], dtype=np.float64) for i, n in enumerate(NAMES)}
+    for w in SHADES:
+        if canonical_color(w) is None:  # "maroon" is an alias of "red", not a colour of its own
+            out[w] = srgb_to_lab(np.array(SHADES[w], dtype=np.float64))
+    return out
+
+
+_NAMED: dict[str, F64] = _named_labs()
+_BASIC_LAB: F64 = np.array([_NAMED[b] for b in BASIC])
+
+
+@lru_cache(maxsize=1024)
+def family(word: str, radius: float = FAMILY_RADIUS) -> tuple[str, ...]:
+    """The colours a spoken word covers, the word itself first: the named colours whose head word
+    it is ("light blue" and "sky blue" for blue, "forest green" for green) and, for a basic term,
+    the named colours within ``radius`` ΔE00 of it and ``FAMILY_MARGIN`` times nearer to it than to
+    any other basic term (mustard for yellow, walnut for brown, light grey for white). A word
+    outside the palette (a shade or a modified colour, "pale pink") covers itself only."""
+    w = word.strip().lower()
+    name = canonical_color(w) or w
+    out = [name]
+    for n, lab in _NAMED.items():
+        if n == name:
+            continue
+        if len(n.split()) > 1 and n.split()[-1] == name:
+            out.append(n)
+        elif name in BASIC:
+            d = ciede2000(lab[None], _BASIC_LAB, kL=2.0)
+            k, second = np.argsort(d)[:2]
+            if BASIC[k] == name and d[k] <= radius and d[second] >= FAMILY_MARGIN * d[k]:
+                out.append(n)
+    return tuple(out)

@@ -265,10 +265,21 @@ class Retriever:
             values["room cue"] = strength
             predicate, mode = "room", "predicate"
             notes.append(f"{int(in_room.sum())} of them appear to be in the {q.room} (inferred from nearby objects)")
-            if not in_room.any() and not unknown.any():
+            # A room is inferred, never observed: refuse only where the evidence against the named
+            # room is confident, i.e. no candidate of the best category tier has a cue of it in its
+            # own room (a wardrobe beside the desk of a room typed "office" by that desk says
+            # "bedroom" too). Weak evidence serves the named object, not a substitute for it.
+            top = weights[pool] >= weights[pool].max()
+            possible = (strength >= self.scene.config.room_min_score) & top
+            if not in_room.any() and not unknown.any() and not possible.any():
                 where = sorted({str(r) for r in rooms})
                 refusal = (f"no {q.category or q.target_phrase} stands in the {q.room}; "
                            f"{'they are' if len(pool) > 1 else 'it is'} in the {', the '.join(where)}")
+            elif not in_room.any() and possible.any():
+                k = int(np.argmax(strength))
+                notes.append(f"none is inferred to be in the {q.room}, but object {self.objects[pool[k]].id} "
+                             f"({self.scene.rooms[pool[k]]}) has {q.room} cues where it stands "
+                             f"({strength[k]:.2f})")
         elif cfg.use_predicates and q.room == HALLWAY and len(pool):
             # A hallway has no characteristic objects: objects of a region without any room's cues
             # first, then the weakest cues of any room. No refusal: an untyped region is weak evidence.
