@@ -60,6 +60,7 @@ _PLACEHOLDERS = {"somewhere", "someplace", "anywhere", "place", "spot", "somethi
 @dataclass(frozen=True)
 class PurposeConfig:
     template: str = "a place where you can {activity}"  # how the activity is embedded
+    normalise: bool = True  # drop a light verb, "you" for the speaker (``normalise_activity``)
     top_k: int = 2  # a category's score: the mean of its top_k gloss cosines
     margin: float = 0.08  # runners-up within this of the best score become alternatives
     min_score: float = 0.2  # below this best score no category serves the activity
@@ -130,7 +131,8 @@ class GlossIndex:
     def scores(self, activity: str, config: PurposeConfig | None = None) -> dict[str, float]:
         """Category -> mean cosine of the (normalised) activity to its ``top_k`` best glosses."""
         cfg = config or PurposeConfig()
-        q = self.embedder.embed([cfg.template.format(activity=normalise_activity(activity))])[0]
+        act = normalise_activity(activity) if cfg.normalise else activity
+        q = self.embedder.embed([cfg.template.format(activity=act)])[0]
         sims = self.E @ q
         per: dict[str, list[float]] = {}
         for cat, s in zip(self.cats, sims, strict=True):
