@@ -69,3 +69,15 @@ def test_sight_ignores_unknown_and_the_objects_own_cells_but_not_a_flush_wall() 
     assert not sees_footprint(occ, flush, cells[1:], polygon_centroid(flush))[0]
     occ.cells[10:40, 80:88] = OCCUPIED  # a tall cabinet between: the east cell loses sight too
     assert not sees_footprint(occ, OBJ, cells[:1], fp_c)[0]
+
+
+def test_without_a_cell_inside_the_margin_the_goal_keeps_what_margin_there_is() -> None:
+    # Behind a wall without a door the object is reached across it: with the aimed margin out of
+    # reach (0.6 m inside the 1 m reach), the cheapest cell within reach would stand ~1 m away, on
+    # the reach's edge, where a footprint mapped a few cm off fails. The nearest cell is chosen.
+    occ = walled(door=False)
+    cfg = PlannerConfig(goal_margin=0.6, prefer_line_of_sight=False)
+    goal = select_goal(occ, OBJ, START, cfg)
+    assert goal.reached_within_reach and "none within 0.40 m" in goal.reason
+    here = footprint_distance(np.asarray(goal.xy).reshape(1, 2), OBJ)[0]
+    assert here < 0.6 and goal.xy[0] < 3.0

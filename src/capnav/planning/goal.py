@@ -54,8 +54,10 @@ def check_footprint(footprint: object) -> NDArray[np.float64]:
 
 def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], start_xy: Any,
                 config: PlannerConfig | None = None, costmap: Costmap | None = None) -> GoalPose:
-    """Nearest reachable free cell within ``config.reach`` of the footprint (preferring
-    ``reach - goal_margin``); else the reachable cell closest to the object, with the reason.
+    """Nearest reachable free cell within ``reach - goal_margin`` of the footprint; else, among the
+    cells within ``config.reach``, the nearest reachable one of those closest to the object (the
+    margin left absorbs the mapped footprint's error); else the reachable cell closest to the
+    object, with the reason.
 
     With ``config.prefer_line_of_sight`` the same two tiers are first tried among the cells that
     see the footprint on the map; when none within reach does, the reason says so.
@@ -85,17 +87,17 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
     if cfg.prefer_line_of_sight and within.size:
         seen = np.zeros(len(rc), dtype=bool)
         seen[within] = sees_footprint(cm.occ, fp, rc[within], polygon_centroid(fp))
-        for limit, why in tiers:
+        for k, (limit, why) in enumerate(tiers):
             ok = np.nonzero(seen & (dist <= limit))[0]
             if ok.size:
-                i = int(ok[np.argmin(cost[ok])])
+                i = _pick(ok, cost, dist, k > 0, spec.resolution)
                 return _pose(rc[i], centres[i], fp, True, why.format(d=dist[i]) + ", in sight of it on the map",
                              float(dist[i]), float(cost[i]))
         blind = f"; none of the {within.size} reachable cells within reach sees the object on the map"
-    for limit, why in tiers:
+    for k, (limit, why) in enumerate(tiers):
         ok = np.nonzero(dist <= limit)[0]
         if ok.size:
-            i = int(ok[np.argmin(cost[ok])])
+            i = _pick(ok, cost, dist, k > 0, spec.resolution)
             return _pose(rc[i], centres[i], fp, True, why.format(d=dist[i]) + blind, float(dist[i]), float(cost[i]))
     if len(rc) == 0:  # pragma: no cover - the start cell itself is always reachable
         raise NotFoundError("no cell is reachable from the start")
@@ -106,6 +108,17 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
     why = (f"no reachable free cell within {cfg.reach:.2f} m of the object; closest reachable cell is "
            f"{dist[i]:.2f} m away")
     return _pose(rc[i], centres[i], fp, False, why, float(dist[i]), float(cost[i]))
+
+
+def _pick(ok: NDArray[np.intp], cost: NDArray[np.float64], dist: NDArray[np.float64], closest: bool,
+          resolution: float) -> int:
+    """The cheapest of the candidate cells ``ok``; with ``closest`` the cheapest of those nearest the
+    object (within half a cell of the nearest). Without a cell ``goal_margin`` inside the reach, the
+    margin that absorbs the mapped footprint's error is what is left: the cheapest cell within
+    reach may stand on its very edge (1.00 m from the mapped lamp, 1.03 m from the lamp)."""
+    if closest:
+        ok = ok[dist[ok] <= dist[ok].min() + 0.5 * resolution]
+    return int(ok[np.argmin(cost[ok])])
 
 
 def _distances(points: NDArray[np.float64], fp: NDArray[np.float64], chunk: int = 65536) -> NDArray[np.float64]:
