@@ -14,9 +14,11 @@ manifest: colour name, room, model size), never from instructions:
   below which size words cannot rank two instances is its 95th percentile.
 * room: the inferred room against the room that holds the object's centre (inferred, unknown,
   wrong), which bounds how often a room refusal ("the X in the kitchen") may be wrong.
-* surface (``capnav.language.surface``): the woven / smooth word the pixels gave against the
-  true material; how often a spoken material would be refused for the object's own material,
-  and for a material of the other kind (a weave for a smooth one and back).
+* surface (``capnav.language.surface``): the woven / smooth word and the grain (woven / grainy /
+  plain) the pixels gave against the true material; how often a spoken material would be refused
+  for the object's own material, and for a material of another family (fabric, leather or wood,
+  velvet or plastic), and how often the object's own material agrees (is confirmed, not only
+  not contradicted).
 * shape (``capnav.language.form``): the shape words the points gave against the true shape
   variant, on the categories whose variants carry the word (round / rectangular tables, stools and
   ottomans; cactus or leafy plants); how often a spoken shape word would be refused for the
@@ -42,7 +44,14 @@ from capnav.language import SceneContext, create_embedder
 from capnav.language.colors import LEX_LAB, NAMES, canonical_color, ciede2000, family
 from capnav.language.context import label_of
 from capnav.language.form import shape_conflict
-from capnav.language.surface import WOVEN_MATERIALS, material_conflict
+from capnav.language.surface import (
+    GRAINED_MATERIALS,
+    PLAIN_MATERIALS,
+    WOVEN_MATERIALS,
+    Surface,
+    grain_agrees,
+    material_conflict,
+)
 from capnav.retrieval.query import ParsedQuery
 from capnav.retrieval.verifier import OfflineVerifier, OfflineVerifierConfig
 from eval_retrieval import build, instance_of
@@ -62,6 +71,45 @@ def true_shape(category: str, variant: str) -> tuple[str, str] | None:
 
 def material_word(material: str) -> str:
     return material.split()[-1]  # "stainless steel" is spoken "steel"
+
+
+#: A material of each family a person would not use for an object of another (own family -> word).
+_OTHER_FAMILY = {"woven": ("leather", "velvet"), "grained": ("fabric", "velvet"), "plain": ("fabric", "wood")}
+
+
+def family(material: str) -> str | None:
+    w = material_word(material)
+    return ("woven" if w in WOVEN_MATERIALS else "grained" if w in GRAINED_MATERIALS
+            else "plain" if w in PLAIN_MATERIALS else None)
+
+
+def report_surface(rows: list[tuple[str, Surface]]) -> None:
+    """rows: (true material, observed surface). The grain table, and for each family how often its
+    own word is refused, confirmed, and another family's word refused."""
+    print(f"\nsurface grain against the true material ({len(rows)} mapped objects)")
+    print("| true material | n | woven | grainy | plain | nothing | own word confirmed | own word refused |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+    by_mat: dict[str, list[Surface]] = {}
+    for mat, s in rows:
+        by_mat.setdefault(mat, []).append(s)
+    for mat in sorted(by_mat):
+        ss = by_mat[mat]
+        c = Counter(s.grain for s in ss)
+        w = material_word(mat)
+        ok = sum(grain_agrees(w, s.grain) for s in ss)
+        bad = sum(bool(material_conflict(w, s.word, s.grain)) for s in ss)
+        print(f"| {mat} | {len(ss)} | {c['woven']} | {c['grainy']} | {c['plain']} | {c[None]} | {ok} | {bad} |")
+    print("| family | objects | own word refused | own word confirmed | other families' words refused |")
+    print("|---|---:|---:|---:|---:|")
+    for fam, others in _OTHER_FAMILY.items():
+        ss = [(material_word(m), s) for m, s in rows if family(m) == fam]
+        if not ss:
+            continue
+        own = np.mean([bool(material_conflict(w, s.word, s.grain)) for w, s in ss])
+        conf = np.mean([grain_agrees(w, s.grain) for w, s in ss])
+        other = np.mean([bool(material_conflict(o, s.word, s.grain)) for _, s in ss for o in others])
+        print(f"| {fam} ({'/'.join(sorted({w for w, _ in ss}))}) | {len(ss)} | {own:.1%} | {conf:.1%} | "
+              f"{other:.1%} ({'/'.join(others)}) |")
 
 
 def report_form(rows: list[tuple[str, str, str, list[str], str | None]]) -> None:
@@ -134,6 +182,7 @@ def main() -> None:
     rooms: Counter[str] = Counter()
     room_rows = []
     form_rows: list[tuple[str, str, str, list[str], str | None]] = []
+    surface_rows: list[tuple[str, Surface]] = []
     for seed in args.seeds:
         cmap, manifest = build(seed, args.work)
         scene = SceneContext(cmap.objects, cmap.occupancy)
@@ -161,6 +210,7 @@ def main() -> None:
                     wrong_agree.append(fit)
                     wrong_rank.append(rank)
             form_rows.append((truth.category, truth.shape, truth.material, judge.shapes(o), judge.surface(o).word))
+            surface_rows.append((truth.material, judge.surface(o)))
             said = scene.room_of(o)
             real = room_name[truth.room]
             verdict = "unknown" if said is None else ("right" if said == real else "wrong")
@@ -201,6 +251,7 @@ def main() -> None:
     for row in room_rows:
         print(f"  wrong room: {row}")
     report_form(form_rows)
+    report_surface(surface_rows)
 
 
 if __name__ == "__main__":

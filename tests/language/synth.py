@@ -152,9 +152,11 @@ def walked_through_the_door(map_file: Path) -> CapNavMap:
     return cmap
 
 
-def textured_view(obj: MapObject, pattern: str, scale: float = 1.0) -> MapObject:
+def textured_view(obj: MapObject, pattern: str, scale: float = 1.0, texel: int | None = None) -> MapObject:
     """Give ``obj`` one view: a crop of the simulator's ``pattern`` texture in the object's median
-    point colour, resampled by ``scale`` (as a renderer samples it), on a wall-coloured margin."""
+    point colour, resampled by ``scale`` (as a renderer samples it), on a wall-coloured margin.
+    With ``texel``, each texel is drawn as a block of that many pixels instead (nearest sampling:
+    how the simulator's renderer draws a near face)."""
     import io
 
     from PIL import Image
@@ -164,8 +166,8 @@ def textured_view(obj: MapObject, pattern: str, scale: float = 1.0) -> MapObject
 
     rgb = tuple(int(v) for v in np.median(np.asarray(obj.colors), axis=0))
     tile = np.tile(texture(pattern, rgb), (2, 2, 1))  # type: ignore[arg-type]
-    n = int(128 * scale)
-    surf = np.asarray(Image.fromarray(tile).resize((n, n), Image.BILINEAR))
+    n = int(128 * scale) if texel is None else 128 * texel
+    surf = np.asarray(Image.fromarray(tile).resize((n, n), Image.BILINEAR if texel is None else Image.NEAREST))
     img = np.full((n + 40, n + 40, 3), (205, 200, 190), np.uint8)
     img[20:20 + n, 20:20 + n] = surf
     buf = io.BytesIO()

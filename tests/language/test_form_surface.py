@@ -11,7 +11,7 @@ import numpy as np
 from capnav.language import SceneContext
 from capnav.language.form import growth, outline, shape_conflict
 from capnav.language.offline_captioner import ObservationCaptioner
-from capnav.language.surface import Surface, material_conflict, surface_of
+from capnav.language.surface import Surface, grain_agrees, material_conflict, surface_of
 
 from .synth import disc_points, make_obj, plant_points, textured_view
 
@@ -45,6 +45,41 @@ def test_weave_is_woven_and_grain_mottle_veins_and_pile_are_smooth():
         words[pattern] = cap.surface(o).word
     assert words == {"fabric": "woven", "cotton": "woven", "leather": "smooth", "wood": "smooth",
                      "marble": "smooth", "metal": "smooth"}
+
+
+def test_simulator_textures_drawn_texel_by_texel_show_their_family():
+    # The renderer draws a near face's texels as blocks of pixels: a weave, wood's grain and
+    # leather's mottle, velvet's pile and the flat plastics each land in their family, on a
+    # bright, a saturated and a dark colour alike.
+    cap = ObservationCaptioner()
+    families = {"fabric": "woven", "cotton": "woven", "wood": "grainy", "leather": "grainy", "velvet": "plain",
+                "plastic": "plain", "ceramic": "plain", "acrylic": "plain"}
+    for rgb in ((200, 190, 170), (170, 60, 70), (60, 45, 35)):
+        for k, pattern in enumerate(families):
+            o = textured_view(make_obj(k + 1, "stool", (0, 0), (0.5, 0.5, 0.7), rgb, shading=(1.0, 1.0)), pattern,
+                              texel=2)
+            assert cap.surface(o).grain == families[pattern], (rgb, pattern, cap.surface(o))
+
+
+def test_a_spoken_material_against_the_grain():
+    assert material_conflict("wooden", "smooth", "plain") and material_conflict("leather", None, "plain")
+    assert material_conflict("velvet", "smooth", "grainy") and material_conflict("plastic", None, "woven")
+    assert material_conflict("cotton", "smooth", "grainy") and material_conflict("leather", None, "woven")
+    assert material_conflict("wood", "smooth", "grainy") is False and grain_agrees("wood", "grainy")
+    assert material_conflict("ceramic", None, "plain") is False and grain_agrees("ceramic", "plain")
+    # Metal's brushed streaks and marble's veins sit between grainy and plain: only a weave refutes them.
+    assert material_conflict("metal", "smooth", "grainy") is False
+    assert material_conflict("marble", None, "plain") is False
+    assert not grain_agrees("metal", "grainy") and material_conflict("steel", None, "woven")
+    # Nothing measured: the weave word decides, as before.
+    assert material_conflict("leather", "woven", None) and material_conflict("wooden", None, None) is None
+
+
+def test_surfaces_of_maps_described_before_grain_still_read():
+    old = Surface.from_list(["smooth", 1.02, 0.2, 900])
+    assert old.word == "smooth" and old.grain is None and old.detail == 0.0
+    s = Surface("smooth", 0.9, 0.2, 5000, "grainy", 14.2, 6.1)
+    assert Surface.from_list(s.to_list()) == s
 
 
 def test_a_plain_painted_surface_is_smooth():
@@ -88,3 +123,16 @@ def test_the_caption_says_the_surface_and_shape_it_observed():
     assert "round table" in texts[1]
     assert "green fabric" in texts[2] and "sofa" in texts[2]
     assert "leafy plant" in texts[3]
+
+
+def test_the_caption_says_grainy_or_smooth_only_when_the_pixels_show_it():
+    stool = textured_view(make_obj(1, "stool", (0, 0), (0.4, 0.4, 0.7), (120, 80, 50), shading=(1.0, 1.0)), "wood",
+                          texel=2)
+    chair = textured_view(make_obj(2, "armchair", (2, 0), (0.8, 0.8, 0.9), (200, 180, 150), shading=(1.0, 1.0)),
+                          "velvet", texel=2)
+    unseen = make_obj(3, "stool", (4, 0), (0.4, 0.4, 0.7), (120, 80, 50))  # no views: nothing to say
+    scene = SceneContext([stool, chair, unseen])
+    cap = ObservationCaptioner()
+    texts = {o.id: cap.caption(o, scene).text for o in (stool, chair, unseen)}
+    assert "grainy stool" in texts[1] and "smooth armchair" in texts[2]
+    assert "grainy" not in texts[3] and "smooth" not in texts[3]

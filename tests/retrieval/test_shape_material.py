@@ -116,3 +116,45 @@ def test_a_size_word_ranks_among_the_cacti(emb):
     assert r.query("the larger cactus").chosen.id == 6
     assert r.query("the smaller cactus").chosen.id == 7
     assert r.query("the bigger plant").chosen.id == 5
+
+
+def grain_room(keep: set[int] | None = None) -> list:
+    """Lookalikes told apart by their grain only: two brown stools (wood, plastic), two beige
+    armchairs (velvet, leather), one olive velvet sofa; texels drawn as the renderer draws a near face."""
+    brown, beige = (110, 75, 50), (205, 185, 150)
+    objs = [
+        textured_view(make_obj(1, "stool", (1.0, 1.0), (0.4, 0.4, 0.7), brown, shading=(1.0, 1.0)), "wood", texel=2),
+        textured_view(make_obj(2, "stool", (3.0, 1.0), (0.4, 0.4, 0.7), brown, shading=(1.0, 1.0)), "plastic",
+                      texel=2),
+        textured_view(make_obj(3, "armchair", (1.0, 4.0), (0.8, 0.8, 0.9), beige, shading=(1.0, 1.0)), "velvet",
+                      texel=2),
+        textured_view(make_obj(4, "armchair", (3.5, 4.0), (0.8, 0.8, 0.9), beige, shading=(1.0, 1.0)), "leather",
+                      texel=2),
+        textured_view(make_obj(5, "sofa", (6.5, 3.0), (2.0, 0.9, 0.8), (120, 120, 60), shading=(1.0, 1.0)), "velvet",
+                      texel=2),
+    ]
+    return [o for o in objs if keep is None or o.id in keep]
+
+
+def grain_retriever(emb, keep: set[int] | None = None) -> Retriever:
+    cmap = make_map(grain_room(keep))
+    describe_map(cmap, None, create_captioner("offline"), emb, progress=False)
+    return Retriever(cmap, emb)
+
+
+def test_the_grain_picks_the_wooden_stool_and_the_plain_one_among_lookalikes(emb):
+    r = grain_retriever(emb)
+    res = r.query("I'd like to go to the wooden stool")
+    assert res.chosen.id == 1 and res.terms.get("material") == 1.0
+    assert r.query("take me to the plastic stool").chosen.id == 2
+    assert r.query("bring me to the leather armchair please").chosen.id == 4
+    assert r.query("the beige velvet armchair").chosen.id == 3
+
+
+def test_a_grain_the_pixels_contradict_is_refused_naming_the_surface(emb):
+    plain = grain_retriever(emb, {2, 3, 5})  # plastic stool, velvet armchair, velvet sofa
+    res = plain.query("go to the leather sofa")
+    assert not res.found and "plain" in res.reason and "leather" in res.reason
+    assert plain.query("go to the velvet sofa").chosen.id == 5
+    res = plain.query("the wooden stool")
+    assert not res.found and "plain" in res.reason

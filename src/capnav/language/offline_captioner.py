@@ -43,7 +43,7 @@ class OfflineCaptionConfig:
     second_color_fraction: float = 0.25  # report a second colour when it covers this share
     min_points: int = 30  # fewer fused points than this: use the views' pixels for colour
     form: FormConfig = field(default_factory=FormConfig)  # shape words from the points
-    surface: SurfaceConfig = field(default_factory=SurfaceConfig)  # woven / smooth from the pixels
+    surface: SurfaceConfig = field(default_factory=SurfaceConfig)  # weave and grain from the pixels
     base_fraction: float = 0.3  # lowest share of the height that holds a plant's pot
 
 
@@ -73,6 +73,10 @@ def footprint_shape(obj: MapObject, cfg: OfflineCaptionConfig) -> str | None:
     return outline(np.asarray(obj.points, dtype=np.float64), cfg.form)
 
 
+#: Caption words for the observed surface (``capnav.language.surface``): a weave, grain (wood's or
+#: leather's), or a plain one (velvet, plastic, paint).
+SURFACE_WORDS = {"woven": "fabric", "grainy": "grainy", "plain": "smooth"}
+
 #: Categories that grow (foliage over a pot).
 _GROWING = {"plant"}
 
@@ -80,7 +84,8 @@ _GROWING = {"plant"}
 class ObservationCaptioner(Captioner):
     """Writes "NAME, one sentence" from the map's observations (no model, deterministic)."""
 
-    model_id = "offline-observation-v3"  # v2: surface, rectangular and growth words; v3: "leafy", not "bushy"
+    model_id = "offline-observation-v4"  # v2: surface, rectangular and growth words; v3: "leafy", not "bushy";
+    # v4: grainy / smooth surfaces
 
     def __init__(self, config: OfflineCaptionConfig | None = None) -> None:
         self.config = config or OfflineCaptionConfig()
@@ -105,7 +110,7 @@ class ObservationCaptioner(Captioner):
         return object_colors(low.reshape(-1, 3), self.config.colors) if len(low) >= 10 else []
 
     def surface(self, obj: MapObject) -> Surface:
-        """Woven or smooth from the views' pixels around the object's median observed colour."""
+        """Weave and grain from the views' pixels around the object's median observed colour."""
         from capnav.language.colors import srgb_to_lab
 
         rgb = np.asarray(obj.colors).reshape(-1, 3)
@@ -151,8 +156,10 @@ class ObservationCaptioner(Captioner):
         shapes = self.shapes(obj, name)
         if shapes:
             out["shape"] = " ".join(shapes)
-        if self.surface(obj).word == "woven":  # "smooth" is said of most objects: no word singles one out
-            out["surface"] = "fabric"
+        surf = self.surface(obj)
+        seen = surf.grain or ("woven" if surf.word == "woven" else None)
+        if seen is not None:
+            out["surface"] = SURFACE_WORDS[seen]
         if obj.id in scene.index:
             rank, count = scene.size_rank(obj)
             if count == 2:

@@ -34,7 +34,7 @@ from capnav.language.embedder import TextEmbedder
 from capnav.language.form import shape_conflict
 from capnav.language.offline_captioner import ObservationCaptioner
 from capnav.language.prompts import Verdict, caption_name, parse_verdict, verification_prompt
-from capnav.language.surface import Surface, material_conflict
+from capnav.language.surface import Surface, grain_agrees, material_conflict
 from capnav.language.vlm.base import RateLimited, VisionLanguageModel, create_vlm
 from capnav.mapping.objects import MapObject
 from capnav.retrieval.query import ParsedQuery
@@ -213,20 +213,25 @@ class OfflineVerifier(Verifier):
 
     def material(self, q: ParsedQuery, obj: MapObject) -> tuple[float | None, str]:
         """(agreement in [0, 1], why) of the spoken materials with the surface the pixels showed:
-        1 a weave seen for a woven material, 0.5 not contradicted (a smooth surface is what every
-        material without a weave shows, so it is no evidence for leather over velvet or marble
-        over ceramic), None contradicted."""
+        1 when the pixels show what the material shows (a weave for fabric, grain for wood or
+        leather, a plain surface for velvet or plastic), 0.5 not contradicted (nothing clear was
+        seen, or the word says nothing the pixels can show: metal, marble), None contradicted."""
         if not q.materials:
             return 0.0, ""
         surf = self.surface(obj)
         vals = []
         for m in q.materials:
-            c = material_conflict(m, surf.word)
+            c = material_conflict(m, surf.word, surf.grain)
+            if c and surf.grain is not None:
+                return None, (f"'{m}' but its pixels show a {surf.grain} surface (brightness detail "
+                              f"{surf.detail:.1f}, fine {surf.fine_detail:.1f})")
             if c:
                 return None, (f"'{m}' but its pixels show a {surf.word} surface (finest/next band "
                               f"{surf.ratio:.2f})")
-            vals.append(1.0 if c is False and surf.word == "woven" else 0.5)
-        return float(np.mean(vals)), f"material {'/'.join(q.materials)} vs {surf.word or 'no clear'} surface"
+            agree = c is False and (grain_agrees(m, surf.grain) or (surf.grain is None and surf.word == "woven"))
+            vals.append(1.0 if agree else 0.5)
+        seen = surf.grain or (surf.word if surf.word == "woven" else None)
+        return float(np.mean(vals)), f"material {'/'.join(q.materials)} vs {seen or 'no clear'} surface"
 
     def _name_sim(self, noun: str, name: str) -> float:
         key = (noun, name)
