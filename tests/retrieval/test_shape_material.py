@@ -120,7 +120,8 @@ def test_a_size_word_ranks_among_the_cacti(emb):
 
 def grain_room(keep: set[int] | None = None) -> list:
     """Lookalikes told apart by their grain only: two brown stools (wood, plastic), two beige
-    armchairs (velvet, leather), one olive velvet sofa; texels drawn as the renderer draws a near face."""
+    armchairs (velvet, leather), one olive velvet sofa, texels drawn as the renderer draws a near
+    face; and a navy chair without views."""
     brown, beige = (110, 75, 50), (205, 185, 150)
     objs = [
         textured_view(make_obj(1, "stool", (1.0, 1.0), (0.4, 0.4, 0.7), brown, shading=(1.0, 1.0)), "wood", texel=2),
@@ -132,6 +133,7 @@ def grain_room(keep: set[int] | None = None) -> list:
                       texel=2),
         textured_view(make_obj(5, "sofa", (6.5, 3.0), (2.0, 0.9, 0.8), (120, 120, 60), shading=(1.0, 1.0)), "velvet",
                       texel=2),
+        make_obj(6, "chair", (6.5, 5.5), (0.5, 0.5, 0.9), (40, 40, 110)),  # never seen up close: no surface
     ]
     return [o for o in objs if keep is None or o.id in keep]
 
@@ -158,3 +160,6 @@ def test_a_grain_the_pixels_contradict_is_refused_naming_the_surface(emb):
     assert plain.query("go to the velvet sofa").chosen.id == 5
     res = plain.query("the wooden stool")
     assert not res.found and "plain" in res.reason
+    # A chair may stand in for a sofa, but not for "the leather sofa" when its surface was not seen.
+    assert not grain_retriever(emb, {5, 6}).query("go to the leather sofa").found
+    assert grain_retriever(emb, {5, 6}).query("go to the sofa").chosen.id == 5

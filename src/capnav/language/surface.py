@@ -251,6 +251,12 @@ def material_conflict(material: str, surface: str | None, grain: str | None = No
     return None
 
 
+def material_shows(material: str) -> bool:
+    """The spoken material has a grain the pixels can confirm (a weave, grain, a plain surface)."""
+    m = material.lower()
+    return m in WOVEN_MATERIALS or m in GRAINED_MATERIALS or m in PLAIN_MATERIALS
+
+
 def grain_agrees(material: str, grain: str | None) -> bool:
     """The observed grain is what the spoken material shows (woven fabric, grainy wood, plain velvet)."""
     m = material.lower()

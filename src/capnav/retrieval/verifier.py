@@ -34,7 +34,7 @@ from capnav.language.embedder import TextEmbedder
 from capnav.language.form import shape_conflict
 from capnav.language.offline_captioner import ObservationCaptioner
 from capnav.language.prompts import Verdict, caption_name, parse_verdict, verification_prompt
-from capnav.language.surface import Surface, grain_agrees, material_conflict
+from capnav.language.surface import Surface, grain_agrees, material_conflict, material_shows
 from capnav.language.vlm.base import RateLimited, VisionLanguageModel, create_vlm
 from capnav.mapping.objects import MapObject
 from capnav.retrieval.query import ParsedQuery
@@ -340,6 +340,11 @@ class OfflineVerifier(Verifier):
         mat, mwhy = self.material(query, c.obj)
         if mat is None:
             return Assessment(False, 0.0, terms, f"{why} but {mwhy}")
+        if weight < 1.0 and mat < 1.0 and any(map(material_shows, query.materials)):
+            # Another category stands in for the named one only when its pixels show the spoken
+            # material: "the leather sofa" is not a chair of unknown surface.
+            return Assessment(False, 0.0, terms, f"{why} but its pixels do not show {'/'.join(query.materials)} "
+                                                 f"({mwhy})")
         if query.materials:
             terms["material"] = round(mat, 3)
         val = (cfg.w_rank * (1.0 - position) + cfg.w_color * col + cfg.w_size * size + cfg.w_shape * shape
