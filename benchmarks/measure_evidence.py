@@ -77,7 +77,7 @@ def material_word(material: str) -> str:
 _OTHER_FAMILY = {"woven": ("leather", "velvet"), "grained": ("fabric", "velvet"), "plain": ("fabric", "wood")}
 
 
-def family(material: str) -> str | None:
+def material_family(material: str) -> str | None:
     w = material_word(material)
     return ("woven" if w in WOVEN_MATERIALS else "grained" if w in GRAINED_MATERIALS
             else "plain" if w in PLAIN_MATERIALS else None)
@@ -102,7 +102,7 @@ def report_surface(rows: list[tuple[str, Surface]]) -> None:
     print("| family | objects | own word refused | own word confirmed | other families' words refused |")
     print("|---|---:|---:|---:|---:|")
     for fam, others in _OTHER_FAMILY.items():
-        ss = [(material_word(m), s) for m, s in rows if family(m) == fam]
+        ss = [(material_word(m), s) for m, s in rows if material_family(m) == fam]
         if not ss:
             continue
         own = np.mean([bool(material_conflict(w, s.word, s.grain)) for w, s in ss])
