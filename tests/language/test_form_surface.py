@@ -136,3 +136,22 @@ def test_the_caption_says_grainy_or_smooth_only_when_the_pixels_show_it():
     texts = {o.id: cap.caption(o, scene).text for o in (stool, chair, unseen)}
     assert "grainy stool" in texts[1] and "smooth armchair" in texts[2]
     assert "grainy" not in texts[3] and "smooth" not in texts[3]
+
+
+def test_a_noisy_camera_leaves_the_grain_unsaid():
+    # A camera's sensor noise covers the wall behind the object as well: no grain or plain surface
+    # is claimed, while the same rendered (noiseless) crop is grainy.
+    import io
+
+    from PIL import Image
+
+    o = textured_view(make_obj(1, "stool", (0, 0), (0.5, 0.5, 0.7), (150, 110, 70), shading=(1.0, 1.0)), "wood",
+                      texel=2)
+    assert ObservationCaptioner().surface(o).grain == "grainy"
+    img = np.asarray(Image.open(io.BytesIO(o.views[0].crop_png)).convert("RGB")).astype(np.float64)
+    noisy = np.clip(img + np.random.default_rng(0).normal(0, 2.5, img.shape), 0, 255).astype(np.uint8)
+    buf = io.BytesIO()
+    Image.fromarray(noisy).save(buf, format="PNG")
+    o.views[0].crop_png = buf.getvalue()
+    s = ObservationCaptioner().surface(o)
+    assert s.grain is None and s.detail > 0
