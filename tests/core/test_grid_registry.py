@@ -1,3 +1,6 @@
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -33,6 +36,26 @@ def test_registry_errors_list_choices() -> None:
     assert reg.create("a") == 1
     with pytest.raises(InputError, match="available: a"):
         reg.create("b")
+
+
+def test_registry_imports_a_backends_module_when_it_is_first_asked_for() -> None:
+    """Backends named with their module register on first use: a query process never imports the
+    PyTorch embedders or the remote model clients."""
+    code = ("import sys\nfrom capnav.language.embedder import EMBEDDERS\n"
+            "from capnav.language.vlm.base import VLMS\n"
+            "assert 'bge-m3' in EMBEDDERS and 'gemini' in VLMS and 'flag' in EMBEDDERS.names()\n"
+            "assert 'capnav.language.st_embedder' not in sys.modules\n"
+            "assert 'capnav.language.vlm.gemini' not in sys.modules\n"
+            "assert EMBEDDERS.required('onnx') == ['path']\n"
+            "print(sorted(m for m in sys.modules if m.startswith('capnav.language.')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    loaded = out.stdout.strip()
+    assert "capnav.language.onnx_embedder" in loaded and "capnav.language.st_embedder" not in loaded
+    reg: Registry[int] = Registry("widget", providers={"tiny": "capnav.nonexistent_module"})
+    assert "tiny" in reg and reg.names() == ["tiny"]
+    with pytest.raises(ModuleNotFoundError):
+        reg.create("tiny")
 
 
 def test_categories_and_synonyms() -> None:

@@ -49,6 +49,26 @@ def test_batching_order_and_cache(minilm):
     assert minilm.embed([]).shape == (0, 384)
 
 
+def test_fast_start_session_gives_the_folded_sessions_vectors():
+    """A one-shot query runs on a session built without constant folding (~0.3 s less to build);
+    after ``warm_up_calls`` runs the folded one takes over. Both give the same vectors."""
+    texts = ["the tall lamp by the bookshelf", "a place where you can cook"]
+    folded = create_embedder("minilm", warm_up_calls=0)
+    assert isinstance(folded, OnnxTextEmbedder)
+    starting = create_embedder("minilm", warm_up_calls=3)
+    assert isinstance(starting, OnnxTextEmbedder)
+    first_session, left = starting._sess, starting._runs_left
+    assert 1 < left <= 3  # (a model without a fixed output width spends one run on a probe)
+    a = starting._encode(texts)  # _encode bypasses the cache: every call is a run
+    for _ in range(left - 2):
+        starting._encode(texts[:1])
+    assert starting._sess is first_session
+    starting._encode(texts[:1])  # the last warm-up run builds the folded session
+    assert starting._sess is not first_session and starting._runs_left == 0
+    np.testing.assert_allclose(a, folded._encode(texts), atol=1e-4)
+    np.testing.assert_allclose(starting._encode(texts), folded._encode(texts), atol=1e-5)
+
+
 def test_bad_input(minilm):
     with pytest.raises(InputError):
         minilm.embed("not a list")

@@ -37,16 +37,13 @@ def register(app: typer.Typer) -> None:
         from capnav.io.mapfile import load_map, save_map
         from capnav.language import create_captioner, create_embedder, describe_map
         from capnav.language.embedder import EMBEDDERS
-        from capnav.language.vlm.base import _MODULES, VLMS
+        from capnav.language.vlm.base import VLMS
 
         check_input_path(map_path, "map file")
         out = output or map_path
         check_output_file(out, "-o" if output is not None else "MAP")
         check_model_folder("--embedder", embedder, embedder_path, "--embedder-path", EMBEDDERS.required(embedder))
-        if captioner in _MODULES:
-            import importlib
-
-            importlib.import_module(f"capnav.language.vlm.{_MODULES[captioner]}")
+        if captioner in VLMS:
             check_model_folder("--captioner", captioner, model_path, "--model-path", VLMS.required(captioner))
         kw: dict[str, object] = {}
         if model:

@@ -161,15 +161,12 @@ def check_map_scene(map_meta: dict[str, object], map_path: Path, scene: int | No
 
 def check_verifier(name: str, flag: str = "--verifier") -> None:
     """An unknown verifier, or one that needs a model folder no command takes, is refused up front."""
-    import importlib
-
     from capnav.core.errors import InputError
-    from capnav.language.vlm.base import _MODULES, VLMS
+    from capnav.language.vlm.base import VLMS
     from capnav.retrieval.verifier import VERIFIERS
 
     VERIFIERS.required(name)  # unknown name: InputError listing the known ones
-    if name in _MODULES:
-        importlib.import_module(f"capnav.language.vlm.{_MODULES[name]}")
+    if name in VLMS:
         if "path" in VLMS.required(name):
             raise InputError(f"{flag} {name} needs a local model folder, which the command line does not take; "
                              "use it from Python (capnav.retrieval.create_verifier) or choose another verifier")

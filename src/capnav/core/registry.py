@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import inspect
 from collections.abc import Callable
 from typing import Any, Generic, TypeVar
@@ -16,11 +17,15 @@ class Registry(Generic[T]):
 
     Each pluggable stage (detector, encoder, captioner, embedder, verifier, planner, method)
     owns one registry; modules register their backends with ``@REGISTRY.register("name")``.
+    ``providers`` names the module that registers a backend, imported when that backend is first
+    looked up: a process pays only for the backends it uses (the Gemini client, PyTorch for
+    sentence-transformers), and a package need not import every backend to fill its registry.
     """
 
-    def __init__(self, kind: str) -> None:
+    def __init__(self, kind: str, providers: dict[str, str] | None = None) -> None:
         self.kind = kind
         self._factories: dict[str, Callable[..., T]] = {}
+        self._providers = dict(providers or {})
 
     def register(self, name: str) -> Callable[[Callable[..., T]], Callable[..., T]]:
         def deco(factory: Callable[..., T]) -> Callable[..., T]:
@@ -32,9 +37,11 @@ class Registry(Generic[T]):
         return deco
 
     def names(self) -> list[str]:
-        return sorted(self._factories)
+        return sorted({*self._factories, *self._providers})
 
     def _factory(self, name: str) -> Callable[..., T]:
+        if name not in self._factories and name in self._providers:
+            importlib.import_module(self._providers[name])  # registers ``name`` as it loads
         try:
             return self._factories[name]
         except KeyError:
@@ -57,4 +64,4 @@ class Registry(Generic[T]):
         return factory(**kwargs)
 
     def __contains__(self, name: object) -> bool:
-        return name in self._factories
+        return name in self._factories or name in self._providers

@@ -54,7 +54,9 @@ class Captioner(ABC):
         return h.hexdigest()
 
 
-CAPTIONERS: Registry[Captioner] = Registry("captioner")
+CAPTIONERS: Registry[Captioner] = Registry("captioner", providers={
+    "offline": "capnav.language.offline_captioner",
+    **dict.fromkeys(["gemini", "openai", "hf-local"], "capnav.language.remote_captioners")})
 
 
 def create_captioner(name: str = "offline", **kwargs: Any) -> Captioner:

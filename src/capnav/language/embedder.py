@@ -75,7 +75,9 @@ class TextEmbedder(ABC):
         return f"{type(self).__name__}(model_id={self.model_id!r}, dim={self.dim})"
 
 
-EMBEDDERS: Registry[TextEmbedder] = Registry("embedder")
+EMBEDDERS: Registry[TextEmbedder] = Registry("embedder", providers={
+    **dict.fromkeys(["minilm", "onnx"], "capnav.language.onnx_embedder"),
+    **dict.fromkeys(["sentence-transformers", "bge-m3", "flag"], "capnav.language.st_embedder")})
 
 
 def create_embedder(name: str = "minilm", **kwargs: Any) -> TextEmbedder:

@@ -7,8 +7,9 @@ one-shot ``capnav query``)."""
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from capnav.core.lazy import lazy_exports
 
 if TYPE_CHECKING:
     from capnav.mapping.cmap import CapNavMap
@@ -43,18 +44,7 @@ _SOURCES = {
     **dict.fromkeys(["VoxelConfig", "VoxelMap", "radial_weight", "random_projection"], "voxel_map"),
 }
 
-
-def __getattr__(name: str) -> Any:
-    mod = _SOURCES.get(name)
-    if mod is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"{__name__}.{mod}"), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted([*globals(), *_SOURCES])
+__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)
 
 
 __all__ = [

@@ -10,8 +10,9 @@ map without a robot position) does not load numba and scipy for the search and t
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from capnav.core.lazy import lazy_exports
 
 if TYPE_CHECKING:
     from capnav.planning.backends import BACKENDS, path_cost
@@ -31,18 +32,7 @@ _SOURCES = {
     **dict.fromkeys(["PlannedPath", "plan_path"], "path"),
 }
 
-
-def __getattr__(name: str) -> Any:
-    mod = _SOURCES.get(name)
-    if mod is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"{__name__}.{mod}"), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted([*globals(), *_SOURCES])
+__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)
 
 
 __all__ = [

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib
 from typing import Any, Protocol, runtime_checkable
 
 from capnav.core.errors import ModelError
@@ -26,12 +25,11 @@ class VisionLanguageModel(Protocol):
         ...
 
 
-VLMS: Registry[VisionLanguageModel] = Registry("vision-language model")
-_MODULES = {"gemini": "gemini", "openai": "openai_compat", "hf-local": "hf_local"}
+VLMS: Registry[VisionLanguageModel] = Registry("vision-language model", providers={
+    "gemini": "capnav.language.vlm.gemini", "openai": "capnav.language.vlm.openai_compat",
+    "hf-local": "capnav.language.vlm.hf_local"})
 
 
 def create_vlm(name: str, **kwargs: Any) -> VisionLanguageModel:
     """``gemini`` (google-genai), ``openai`` (any OpenAI-compatible chat API), ``hf-local``."""
-    if name in _MODULES and name not in VLMS:
-        importlib.import_module(f"capnav.language.vlm.{_MODULES[name]}")
     return VLMS.create(name, **kwargs)
