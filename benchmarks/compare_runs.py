@@ -16,12 +16,10 @@ import json
 from pathlib import Path
 from typing import Any
 
+from capnav.eval.report import pct
+
 ORDER = ("capnav", "capnav-no-heuristic", "capnav-no-verify", "category-only", "vlmaps", "cow", "zson",
          "lmnav", "random-object")
-
-
-def _pct(x: float | None) -> str:
-    return "–" if x is None else f"{100 * x:.1f}"
 
 
 def load(arg: str) -> tuple[str, dict[str, Any]]:
@@ -67,8 +65,8 @@ def table(runs: list[tuple[str, dict[str, Any]]], protocol: str) -> list[str]:
         for b in by:
             s = b.get(m)
             cells.append("–" if s is None else
-                         f"{_pct(s['independent'])} / {_pct(s.get('independent_strict'))} / "
-                         f"{_pct(s['in_a_row'][-1] if s['in_a_row'] else None)}")
+                         f"{pct(s['independent'])} / {pct(s.get('independent_strict'))} / "
+                         f"{pct(s['in_a_row'][-1] if s['in_a_row'] else None)}")
         lines.append(f"| {m} | " + " | ".join(cells) + " |")
     return lines
 

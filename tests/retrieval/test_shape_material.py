@@ -46,8 +46,9 @@ def room(keep: set[int] | None = None) -> list:
     return [o for o in objs if keep is None or o.id in keep]
 
 
-def retriever(emb, keep: set[int] | None = None) -> Retriever:
-    cmap = make_map(room(keep))
+def retriever(emb, keep: set[int] | None = None, scene=None) -> Retriever:
+    """The offline-captioned map of ``scene`` (default: ``room``), only objects ``keep`` if given."""
+    cmap = make_map((scene or room)(keep))
     describe_map(cmap, None, create_captioner("offline"), emb, progress=False)
     return Retriever(cmap, emb)
 
@@ -138,14 +139,8 @@ def grain_room(keep: set[int] | None = None) -> list:
     return [o for o in objs if keep is None or o.id in keep]
 
 
-def grain_retriever(emb, keep: set[int] | None = None) -> Retriever:
-    cmap = make_map(grain_room(keep))
-    describe_map(cmap, None, create_captioner("offline"), emb, progress=False)
-    return Retriever(cmap, emb)
-
-
 def test_the_grain_picks_the_wooden_stool_and_the_plain_one_among_lookalikes(emb):
-    r = grain_retriever(emb)
+    r = retriever(emb, scene=grain_room)
     res = r.query("I'd like to go to the wooden stool")
     assert res.chosen.id == 1 and res.terms.get("material") == 1.0
     assert r.query("take me to the plastic stool").chosen.id == 2
@@ -154,12 +149,12 @@ def test_the_grain_picks_the_wooden_stool_and_the_plain_one_among_lookalikes(emb
 
 
 def test_a_grain_the_pixels_contradict_is_refused_naming_the_surface(emb):
-    plain = grain_retriever(emb, {2, 3, 5})  # plastic stool, velvet armchair, velvet sofa
+    plain = retriever(emb, {2, 3, 5}, grain_room)  # plastic stool, velvet armchair, velvet sofa
     res = plain.query("go to the leather sofa")
     assert not res.found and "plain" in res.reason and "leather" in res.reason
     assert plain.query("go to the velvet sofa").chosen.id == 5
     res = plain.query("the wooden stool")
     assert not res.found and "plain" in res.reason
     # A chair may stand in for a sofa, but not for "the leather sofa" when its surface was not seen.
-    assert not grain_retriever(emb, {5, 6}).query("go to the leather sofa").found
-    assert grain_retriever(emb, {5, 6}).query("go to the sofa").chosen.id == 5
+    assert not retriever(emb, {5, 6}, grain_room).query("go to the leather sofa").found
+    assert retriever(emb, {5, 6}, grain_room).query("go to the sofa").chosen.id == 5

@@ -25,7 +25,8 @@ def paper_row(method: str) -> Any:
     return TABLE1.get(k) or TABLE1.get(k.replace("-", ""))
 
 
-def _pct(x: float | None) -> str:
+def pct(x: float | None) -> str:
+    """A fraction as a percentage with one decimal; "–" when there is none."""
     return "–" if x is None else f"{100.0 * x:.1f}"
 
 
@@ -45,10 +46,10 @@ def table1(summaries: Sequence[Summary], protocol: str = "label") -> list[str]:
         p = paper_row(s.method)
         paper = " / ".join(f"{v:g}" for v in p.in_a_row) if p else "–"
         paper_ind = f"{p.independent:g}" if p else "–"
-        row = " | ".join(_pct(v) for v in s.in_a_row)
-        strict = " / ".join(_pct(v) for v in s.in_a_row_strict) if s.in_a_row_strict else "–"
-        lines.append(f"| {s.method} | {row} | {_pct(s.independent)} | {_pct(s.spl)} | {strict} "
-                     f"| {_pct(s.independent_strict)} |" + (f" {paper} | {paper_ind} |" if paper_cols else ""))
+        row = " | ".join(pct(v) for v in s.in_a_row)
+        strict = " / ".join(pct(v) for v in s.in_a_row_strict) if s.in_a_row_strict else "–"
+        lines.append(f"| {s.method} | {row} | {pct(s.independent)} | {pct(s.spl)} | {strict} "
+                     f"| {pct(s.independent_strict)} |" + (f" {paper} | {paper_ind} |" if paper_cols else ""))
     return lines
 
 
@@ -62,7 +63,7 @@ def table2(summaries: Sequence[Summary]) -> list[str]:
         lab, des = by.get((name, "label")), by.get((name, "description"))
         if lab is None and des is None:
             continue
-        cells = [_pct(s.in_a_row[-1] if s else None) + " | " + _pct(s.independent if s else None) for s in (lab, des)]
+        cells = [pct(s.in_a_row[-1] if s else None) + " | " + pct(s.independent if s else None) for s in (lab, des)]
         lines.append(f"| {name} ({label}) | {cells[0]} | {cells[1]} | {psr:.1f} | {psub:.1f} |")
     return lines
 
@@ -91,8 +92,8 @@ def details(summaries: Sequence[Summary]) -> list[str]:
              "| Path / subgoal (m) | Query time mean / p50 (ms) | Crashes |",
              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for s in _sorted(summaries):
-        lines.append(f"| {s.method} | {s.protocol} | {s.episodes} | {s.subgoals} | {_pct(s.independent)} "
-                     f"| {_pct(s.spl)} | {_pct(s.retrieval_top1)} | {_pct(s.found_rate)} | {s.path_length:.2f} "
+        lines.append(f"| {s.method} | {s.protocol} | {s.episodes} | {s.subgoals} | {pct(s.independent)} "
+                     f"| {pct(s.spl)} | {pct(s.retrieval_top1)} | {pct(s.found_rate)} | {s.path_length:.2f} "
                      f"| {1e3 * s.query_time_mean_s:.1f} / {1e3 * s.query_time_p50_s:.1f} | {s.crashes} |")
     return lines
 
@@ -111,9 +112,9 @@ def standings(summaries: Sequence[Summary], protocol: str, reference: str = "cap
             continue
         others = [(m, get(s)) for m, s in rows.items() if m != reference and get(s) is not None]
         ties = [m for m, v in others if abs(v - r) < 5e-4]
-        above = [f"{m} ({_pct(v)})" for m, v in others if v - r >= 5e-4]
+        above = [f"{m} ({pct(v)})" for m, v in others if v - r >= 5e-4]
         below = [m for m, v in others if r - v >= 5e-4]
-        out.append(f"- {rule}: {reference} {_pct(r)}% of subgoals; "
+        out.append(f"- {rule}: {reference} {pct(r)}% of subgoals; "
                    f"tied by {', '.join(ties) if ties else 'no other method'}; "
                    f"above it: {', '.join(above) if above else 'none'}; below it: {len(below)} of {len(others)}.")
     return ["", "Standing against CapNav (independent subgoal success):", "", *out] if out else []
