@@ -15,7 +15,7 @@ import pytest
 from capnav.eval.parallel import run_tasks
 
 
-def test_ctrl_c_stops_the_workers_long_before_their_tasks_end() -> None:
+def test_ctrl_c_stops_the_workers_within_two_seconds() -> None:
     import multiprocessing
 
     timer = threading.Timer(4.0, os.kill, args=(os.getpid(), signal.SIGINT))  # workers are up by then
@@ -27,9 +27,7 @@ def test_ctrl_c_stops_the_workers_long_before_their_tasks_end() -> None:
     finally:
         timer.cancel()
     stopped = time.monotonic() - t0 - 4.0
-    # The tasks sleep 60 s; stopping takes well under a second on an idle machine. The bound is
-    # loose because a machine shared with benchmark runs (load 6 on 2 cores) took over 2 s.
-    assert stopped < 10.0, stopped
+    assert stopped < 2.0, stopped
     assert not [p for p in multiprocessing.active_children() if p.is_alive()]
 
 
