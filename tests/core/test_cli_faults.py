@@ -191,7 +191,10 @@ def test_interrupted_sim_overwrite_keeps_the_old_dataset_and_stops_fast(data: di
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     proc = subprocess.Popen([sys.executable, "-m", "capnav.cli", "sim", "-o", str(ds), "--overwrite", "--seed", "0",
                              "--frames", "400", "--width", "64", "--height", "48"], env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            # SIGINT as a terminal delivers it, even when this test runs in the
+                            # background of a non-interactive shell (which starts it ignored).
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 120
     while not any(p.name.startswith(".ds.tmp-") and (p / "rgb").is_dir() and any((p / "rgb").iterdir())
                   for p in tmp_path.iterdir()):
