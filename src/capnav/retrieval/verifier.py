@@ -223,10 +223,10 @@ class OfflineVerifier(Verifier):
         for m in q.materials:
             c = material_conflict(m, surf.word, surf.grain)
             if c and surf.grain is not None:
-                return None, (f"'{m}' but its pixels show a {surf.grain} surface (brightness detail "
+                return None, (f"'{m}' while its pixels show a {surf.grain} surface (brightness detail "
                               f"{surf.detail:.1f}, fine {surf.fine_detail:.1f})")
             if c:
-                return None, (f"'{m}' but its pixels show a {surf.word} surface (finest/next band "
+                return None, (f"'{m}' while its pixels show a {surf.word} surface (finest/next band "
                               f"{surf.ratio:.2f})")
             agree = c is False and (grain_agrees(m, surf.grain) or (surf.grain is None and surf.word == "woven"))
             vals.append(1.0 if agree else 0.5)
