@@ -309,3 +309,19 @@ def test_a_purpose_brings_the_lexicon_s_relatives_of_what_serves_it(emb):
     q = parse_instruction("where could I sit for a minute in the office", emb)
     assert {"chair", "stool"} <= {q.category, *q.category_alternatives}, q.to_dict()
     assert q.category_alternatives["stool"] < q.category_alternatives.get("chair", 1.0)
+
+
+def test_a_purpose_and_its_instruction_are_embedded_in_one_model_run(monkeypatch) -> None:
+    """A one-shot query by purpose pays one model run for the activity and the instruction."""
+    from capnav.language import create_embedder
+    from capnav.language.purpose import gloss_index
+
+    emb = create_embedder("minilm")
+    gloss_index(emb)  # the glosses' own (one-off) run
+    runs: list[list[str]] = []
+    encode = emb._encode
+    monkeypatch.setattr(emb, "_encode", lambda texts: runs.append(list(texts)) or encode(texts))
+    text = "somewhere I could sleep for an hour"
+    assert parse_instruction(text, emb).category is not None
+    emb.embed([text])  # what the retriever asks next: served from the cache
+    assert len(runs) == 1 and text in runs[0], runs

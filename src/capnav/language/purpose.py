@@ -25,6 +25,7 @@ from __future__ import annotations
 import base64
 import hashlib
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -128,11 +129,16 @@ class GlossIndex:
         return {"model": self.embedder.model_id, "digest": self.digest, "shape": list(self.E.shape),
                 "float32_le": base64.b64encode(np.ascontiguousarray(self.E, dtype="<f4").tobytes()).decode("ascii")}
 
-    def scores(self, activity: str, config: PurposeConfig | None = None) -> dict[str, float]:
-        """Category -> mean cosine of the (normalised) activity to its ``top_k`` best glosses."""
+    def scores(self, activity: str, config: PurposeConfig | None = None,
+               along: Sequence[str] = ()) -> dict[str, float]:
+        """Category -> mean cosine of the (normalised) activity to its ``top_k`` best glosses.
+
+        ``along``: texts the caller embeds next (the instruction itself), run in the same batch so
+        that the embedder's cache serves them: one model run instead of two, which is most of a
+        one-shot query's model time."""
         cfg = config or PurposeConfig()
         act = normalise_activity(activity) if cfg.normalise else activity
-        q = self.embedder.embed([cfg.template.format(activity=act)])[0]
+        q = self.embedder.embed([cfg.template.format(activity=act), *along])[0]
         sims = self.E @ q
         per: dict[str, list[float]] = {}
         for cat, s in zip(self.cats, sims, strict=True):
@@ -175,8 +181,9 @@ def gloss_index(embedder: TextEmbedder) -> GlossIndex:
     return _INDEXES[key]
 
 
-def match_purpose(activity: str, embedder: TextEmbedder, config: PurposeConfig | None = None) -> PurposeMatch:
-    return PurposeMatch(activity, gloss_index(embedder).scores(activity, config))
+def match_purpose(activity: str, embedder: TextEmbedder, config: PurposeConfig | None = None,
+                  along: Sequence[str] = ()) -> PurposeMatch:
+    return PurposeMatch(activity, gloss_index(embedder).scores(activity, config, along))
 
 
 def purpose_categories(match: PurposeMatch, config: PurposeConfig | None = None) -> tuple[str | None, dict[str, float]]:

@@ -584,7 +584,8 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> Parsed
         if activity is not None:
             q.purpose = activity
             if embedder is not None:
-                best, alts = purpose_categories(match_purpose(activity, embedder))
+                # The retriever embeds the instruction next: one batch for both.
+                best, alts = purpose_categories(match_purpose(activity, embedder, along=(q.text,)))
                 if best is not None:
                     # The lexicon's relatives of each category that serves (a stool beside a chair),
                     # weighted below it: a room or a landmark can then choose among them.
