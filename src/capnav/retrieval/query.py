@@ -497,6 +497,8 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> Parsed
     head = _room_with(q, head)
     # Room: "in the kitchen", "in the living room".
     for phrase in sorted(ROOM_SYNONYMS, key=len, reverse=True):
+        if phrase not in head:  # cheap test first: a one-shot query compiles only the patterns it needs
+            continue
         # Not when the room word modifies an object noun ("at the end of the kitchen counter").
         pat = rf"\b(?:in|inside|within|from|of)\s+(?:the\s+|my\s+|our\s+)?{re.escape(phrase)}\b"
         m = next((m for m in re.finditer(pat, head) if not _form_follows(head, m.end())), None)
@@ -516,7 +518,7 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> Parsed
     # Proximity to the robot (checked before relations so that "closest to me" is not a relation).
     if q.proximity is None:
         for phrase in sorted(_PROXIMITY, key=len, reverse=True):
-            if re.search(rf"\b{phrase}\b", head):
+            if phrase in head and re.search(rf"\b{phrase}\b", head):
                 q.proximity = _PROXIMITY[phrase]
                 head = re.sub(rf"\b{phrase}\b", " ", head)
                 break
@@ -531,7 +533,7 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> Parsed
     # Relation: "<target> next to the <anchor>".
     if q.anchor_category is None:
         for rel in _RELATIONS:
-            m = re.search(rf"\b{rel}\s+(?:the\s+|a\s+|an\s+|my\s+)?(.+)$", head)
+            m = re.search(rf"\b{rel}\s+(?:the\s+|a\s+|an\s+|my\s+)?(.+)$", head) if rel in head else None
             if m and m.start() > 0:
                 anchor_words = m.group(1).split()
                 cat, _, _ = _find_category(anchor_words)
@@ -543,7 +545,7 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None) -> Parsed
                     break
     words = [w for w in re.split(r"\s+", head.strip()) if w]
     for phrase in sorted(_SUPERLATIVE, key=len, reverse=True):
-        if re.search(rf"\b{phrase}\b", head):
+        if phrase in head and re.search(rf"\b{phrase}\b", head):
             q.superlative = _SUPERLATIVE[phrase]
             break
     q.size_word = _size_word(words)
