@@ -79,3 +79,15 @@ def test_a_baseline_that_ties_capnav_is_named() -> None:
     line = next(ln for ln in md.splitlines() if ln.startswith("- paper rule:"))
     assert "capnav 90.0%" in line and "tied by category-only" in line
     assert "above it: cow (95.0)" in line and "below it: 1 of 3" in line
+
+
+def test_a_phrasing_run_shows_only_its_own_table_without_chains() -> None:
+    """A run of hand-written instructions has one subgoal per episode: no empty label or description
+    tables, no in-a-row columns."""
+    sums = [summ("capnav", "phrasing", [0.9, 0.0, 0.0, 0.0], 0.9),
+            summ("category-only", "phrasing", [0.5, 0.0, 0.0, 0.0], 0.5)]
+    md = render(sums, {"seed": 0, "scenes": 1, "scene_seeds": [61], "episodes_per_scene": 9,
+                       "instructions": "dev.jsonl"})
+    assert "## Table 1" not in md and "## Table 2" not in md and "## Description protocol" not in md
+    assert "| Method | Success | SPL | Strict success |" in md
+    assert next(ln for ln in md.splitlines() if ln.startswith("| capnav |")).startswith("| capnav | 90.0 | 50.0 |")

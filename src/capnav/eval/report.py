@@ -39,6 +39,8 @@ def table1(summaries: Sequence[Summary], protocol: str = "label") -> list[str]:
     """In-a-row success for 1..4 subgoals and independent success, under the paper's rule and the
     strict one; the paper's numbers beside ours only for its own (label-only) protocol."""
     paper_cols = protocol == "label"
+    if protocol == "phrasing":  # one subgoal per episode: no chains to count
+        return _single(summaries, protocol)
     lines = ["| Method | 1 | 2 | 3 | 4 | Indep. | SPL | Strict 1 / 2 / 3 / 4 | Strict indep. "
              + ("| Paper 1 / 2 / 3 / 4 | Paper indep. |" if paper_cols else "|"),
              "|---|---:|---:|---:|---:|---:|---:|---|---:|" + ("---|---:|" if paper_cols else "")]
@@ -50,6 +52,14 @@ def table1(summaries: Sequence[Summary], protocol: str = "label") -> list[str]:
         strict = " / ".join(pct(v) for v in s.in_a_row_strict) if s.in_a_row_strict else "–"
         lines.append(f"| {s.method} | {row} | {pct(s.independent)} | {pct(s.spl)} | {strict} "
                      f"| {pct(s.independent_strict)} |" + (f" {paper} | {paper_ind} |" if paper_cols else ""))
+    return lines
+
+
+def _single(summaries: Sequence[Summary], protocol: str) -> list[str]:
+    """Success, SPL and strict success of one-subgoal episodes (the free-phrasing protocol)."""
+    lines = ["| Method | Success | SPL | Strict success |", "|---|---:|---:|---:|"]
+    for s in _sorted([s for s in summaries if s.protocol == protocol]):
+        lines.append(f"| {s.method} | {pct(s.independent)} | {pct(s.spl)} | {pct(s.independent_strict)} |")
     return lines
 
 
@@ -145,20 +155,23 @@ def render(summaries: Sequence[Summary], config: Mapping[str, Any],
     out += ["", "Success is the paper's rule (the agent stops within 1 m of a goal instance's footprint); "
             "*strict* also asks that it sees the object: a straight line from the stop point to the "
             "footprint that no wall and no object 1 m or taller crosses (`capnav.sim.sightline`).", ""]
-    out += ["", "## Table 1: multi-object navigation, label-only protocol (success %, in a row)", ""]
-    out += table1(summaries, "label")
-    out += standings(summaries, "label")
-    out += ["", "## Table 2: ablations (full-chain success rate and subgoal success rate, %)", ""]
-    out += table2(summaries)
-    out += ["", "## Description protocol: reach the one described instance among lookalikes (%)", "",
-            "Not in the paper, so no paper numbers beside it.", ""]
-    out += table1(summaries, "description")
-    out += standings(summaries, "description")
-    if any(s.protocol == "phrasing" for s in summaries):
+    protocols = {s.protocol for s in summaries}  # a table only for the protocols this run measured
+    if "label" in protocols:
+        out += ["", "## Table 1: multi-object navigation, label-only protocol (success %, in a row)", ""]
+        out += table1(summaries, "label")
+        out += standings(summaries, "label")
+    if protocols & {"label", "description"}:
+        out += ["", "## Table 2: ablations (full-chain success rate and subgoal success rate, %)", ""]
+        out += table2(summaries)
+    if "description" in protocols:
+        out += ["", "## Description protocol: reach the one described instance among lookalikes (%)", "",
+                "Not in the paper, so no paper numbers beside it.", ""]
+        out += table1(summaries, "description")
+        out += standings(summaries, "description")
+    if "phrasing" in protocols:
         out += ["", "## Free phrasings: hand-written instructions (success %)", "",
                 f"Instructions from `{config.get('instructions', 'a file')}`, one subgoal each, judged like the "
-                "description protocol; an absent target succeeds when the method answers 'not found'. "
-                "The 'in a row' columns equal the independent figure here.", ""]
+                "description protocol; an absent target succeeds when the method answers 'not found'.", ""]
         out += table1(summaries, "phrasing")
         out += standings(summaries, "phrasing")
         if records:
