@@ -90,4 +90,5 @@ def test_a_phrasing_run_shows_only_its_own_table_without_chains() -> None:
                        "instructions": "dev.jsonl"})
     assert "## Table 1" not in md and "## Table 2" not in md and "## Description protocol" not in md
     assert "| Method | Success | SPL | Strict success |" in md
+    assert "episodes from `dev.jsonl`" in md and "episodes per apartment" not in md
     assert next(ln for ln in md.splitlines() if ln.startswith("| capnav |")).startswith("| capnav | 90.0 | 50.0 |")

@@ -139,8 +139,9 @@ def render(summaries: Sequence[Summary], config: Mapping[str, Any],
     out = ["# CapNav benchmark report", ""]
     out.append(f"capnav {config.get('version', '?')} (commit {config.get('commit', '?')}), seed {config.get('seed')}, "
                f"{config.get('scenes')} apartments (scene seeds {config.get('scene_seeds')}), "
-               f"{config.get('episodes_per_scene')} episodes per apartment and protocol, "
-               f"detector `{config.get('detector', '?')}`, embedder `{config.get('embedder', '?')}`.")
+               + (f"episodes from `{config['instructions']}`, " if config.get("instructions") else
+                  f"{config.get('episodes_per_scene')} episodes per apartment and protocol, ")
+               + f"detector `{config.get('detector', '?')}`, embedder `{config.get('embedder', '?')}`.")
     out.append("")
     track = config.get("track", "default houses, primitives furniture, sim:default detector")
     out.append(f"Track: **{track}**; every table below belongs to this track.")
