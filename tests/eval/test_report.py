@@ -92,3 +92,11 @@ def test_a_phrasing_run_shows_only_its_own_table_without_chains() -> None:
     assert "| Method | Success | SPL | Strict success |" in md
     assert "episodes from `dev.jsonl`" in md and "episodes per apartment" not in md
     assert next(ln for ln in md.splitlines() if ln.startswith("| capnav |")).startswith("| capnav | 90.0 | 50.0 |")
+
+
+def test_the_console_line_of_a_phrasing_run_has_no_chains() -> None:
+    from capnav.cli.eval import summary_line
+
+    assert "in a row" not in summary_line(summ("capnav", "phrasing", [0.9, 0.0, 0.0, 0.0], 0.9))
+    assert "in a row 100 / 50 / 50 / 25, indep. 62.5%" in summary_line(summ("capnav", "label",
+                                                                            [1.0, 0.5, 0.5, 0.25], 0.625))

@@ -5,11 +5,14 @@ from __future__ import annotations
 import shlex
 import sys
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
 from capnav.cli.options import Height, MaxFrames, Seed, Width, check_output_dir, on_interrupt
+
+if TYPE_CHECKING:
+    from capnav.eval.metrics import Summary
 
 
 def register(app: typer.Typer) -> None:
@@ -101,8 +104,13 @@ def register(app: typer.Typer) -> None:
                             command=" ".join(["capnav", *map(shlex.quote, sys.argv[1:])]), episode_sets=sets)
         con = Console()
         for s in res.summaries:
-            con.print(f"{s.method:>20} {s.protocol:>11}: in a row {' / '.join(f'{100 * v:.0f}' for v in s.in_a_row)}"
-                      f", indep. {100 * s.independent:.1f}%, SPL {100 * s.spl:.1f}"
-                      + (f", strict indep. {100 * s.independent_strict:.1f}%" if s.independent_strict is not None
-                         else ""))
+            con.print(summary_line(s))
         con.print(f"{len(res.records)} subgoals in {res.seconds:.0f} s; report: {res.out / 'report.md'}")
+
+
+def summary_line(s: Summary) -> str:
+    """One method and protocol on the console; a hand-written instruction is one subgoal, so its
+    line has no in-a-row figures."""
+    chain = "" if s.protocol == "phrasing" else f"in a row {' / '.join(f'{100 * v:.0f}' for v in s.in_a_row)}, "
+    strict = f", strict indep. {100 * s.independent_strict:.1f}%" if s.independent_strict is not None else ""
+    return f"{s.method:>20} {s.protocol:>11}: {chain}indep. {100 * s.independent:.1f}%, SPL {100 * s.spl:.1f}{strict}"
