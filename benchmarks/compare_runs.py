@@ -46,8 +46,11 @@ def header(runs: list[tuple[str, dict[str, Any]]]) -> list[str]:
         span = f"{len(seeds)} ({seeds[0]}-{seeds[-1]})" if seeds else "–"
         subgoals = sum(s["subgoals"] for s in r["summaries"] if s["method"] == "capnav")
         episodes = sum(s["episodes"] for s in r["summaries"] if s["method"] == "capnav")
-        lines.append(f"| {label} | {r.get('track', '–')} | {r.get('commit', '–')} | {span} | {episodes} | {subgoals} "
-                     f"| {r['seconds'] / 60:.1f} | {cpu_minutes(r):.1f} | `{r.get('command', '')}` |")
+        # A resumed run: the apartments' own commits, and a wall clock that is only the last sitting's.
+        commit = ", ".join(r.get("scene_commits") or [r.get("commit", "–")])
+        wall = f"{r['seconds'] / 60:.1f}" + (" (last sitting; resumed)" if r.get("resumed_scenes") else "")
+        lines.append(f"| {label} | {r.get('track', '–')} | {commit} | {span} | {episodes} | {subgoals} "
+                     f"| {wall} | {cpu_minutes(r):.1f} | `{r.get('command', '')}` |")
     return lines
 
 

@@ -138,3 +138,23 @@ def test_the_perception_track_is_named_and_part_of_the_map_key() -> None:
     assert PipelineConfig(size="large").sim_config().layout.min_rooms == 8
     assert real.sim_config().furniture == "sh3d"
     assert sim.map_key(0, 0) != real.map_key(0, 0)
+
+
+def test_a_resumed_run_says_which_apartments_it_reused(run: tuple[Path, object], tmp_path: Path) -> None:
+    """Rerunning into a finished run's folder reuses its apartments; the results and the report say
+    so, with the commit that computed them, rather than passing this sitting's wall clock and commit
+    off as the whole run's."""
+    import shutil
+
+    out, res = run
+    again = tmp_path / "again"
+    shutil.copytree(out, again)
+    second = run_benchmark(CFG, again, workers=1, progress=False)
+    assert [r.to_dict() for r in second.records] == [r.to_dict() for r in res.records]  # type: ignore[attr-defined]
+    results = json.loads((again / "results.json").read_text())
+    first = json.loads((out / "results.json").read_text())
+    assert first["resumed_scenes"] == [] and "wall clock (whole run)" in first["timings"]
+    assert results["resumed_scenes"] == [4000] and "wall clock (this sitting)" in results["timings"]
+    assert results["scene_commits"] == first["scene_commits"] and results["scene_commits"] != []
+    assert "Resumed run: apartments [4000]" in (again / "report.md").read_text()
+    assert "Resumed run" not in (out / "report.md").read_text()

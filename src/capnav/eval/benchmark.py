@@ -17,7 +17,6 @@ Run folder layout::
 from __future__ import annotations
 
 import json
-import subprocess
 import time
 from collections import defaultdict
 from dataclasses import asdict, dataclass
@@ -31,7 +30,7 @@ from capnav.eval.method import load_methods, method_note
 from capnav.eval.metrics import SubgoalRecord, Summary, summarize_all
 from capnav.eval.parallel import run_tasks
 from capnav.eval.report import render
-from capnav.eval.scene_task import EvalConfig, SceneTask, run_scene
+from capnav.eval.scene_task import EvalConfig, SceneTask, run_scene, version_and_commit
 
 
 @dataclass
@@ -46,21 +45,6 @@ class BenchmarkResult:
             if s.method == method and s.protocol == protocol:
                 return s
         raise InputError(f"no results for {method} / {protocol}")
-
-
-def _version() -> tuple[str, str]:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        v = version("capnav")
-    except PackageNotFoundError:  # pragma: no cover - running from a source tree
-        v = "unknown"
-    try:
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                                cwd=Path(__file__).parent, timeout=5).stdout.strip() or "unknown"
-    except (OSError, subprocess.SubprocessError):
-        commit = "unknown"
-    return v, commit
 
 
 def load_episode_dir(path: Path, protocols: tuple[str, ...]) -> dict[str, EpisodeSet]:
@@ -96,7 +80,7 @@ def run_benchmark(config: EvalConfig, out: str | Path, workers: int = 1, ray_add
         raise InputError(f"episodes given for protocol(s) {', '.join(missing)} that the run does not include")
     if given:
         scene_seeds = sorted({s for es in given.values() for s in es.scene_seeds})
-    version, commit = _version()
+    version, commit = version_and_commit()
     meta = {"version": version, "commit": commit, "seed": config.seed, "scenes": len(scene_seeds),
             "scene_seeds": scene_seeds, "episodes_per_scene": config.episodes_per_scene,
             "detector": f"{config.pipeline.detector}:{config.pipeline.detector_noise}",
@@ -129,7 +113,12 @@ def run_benchmark(config: EvalConfig, out: str | Path, workers: int = 1, ray_add
         for k, v in res["timings"].items():
             timings[k] += float(v)
     seconds = time.perf_counter() - t0
-    timings["wall clock (whole run)"] = seconds
+    # A resumed run reuses apartments finished in an earlier sitting (maybe at another commit): say
+    # which, and that the wall clock is this sitting's (the stage times above cover every apartment).
+    resumed = [res["scene_seed"] for res in results if res.get("resumed")]
+    meta["resumed_scenes"] = resumed
+    meta["scene_commits"] = sorted({str(res.get("commit", "unknown")) for res in results})
+    timings["wall clock (this sitting)" if resumed else "wall clock (whole run)"] = seconds
     failures = [f for res in results for f in res["failures"]]
     write_json(out / "results.json", {**meta, "seconds": seconds, "timings": dict(timings),
                                       "summaries": [s.to_dict() for s in summaries],

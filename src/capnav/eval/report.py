@@ -143,6 +143,11 @@ def render(summaries: Sequence[Summary], config: Mapping[str, Any],
                   f"{config.get('episodes_per_scene')} episodes per apartment and protocol, ")
                + f"detector `{config.get('detector', '?')}`, embedder `{config.get('embedder', '?')}`.")
     out.append("")
+    if config.get("resumed_scenes"):
+        out.append(f"Resumed run: apartments {config['resumed_scenes']} were finished in an earlier sitting and "
+                   f"reused; apartments were computed at commit(s) {', '.join(config.get('scene_commits', []))}. "
+                   "The wall clock below is this sitting's; the stage times cover every apartment.")
+        out.append("")
     track = config.get("track", "default houses, primitives furniture, sim:default detector")
     out.append(f"Track: **{track}**; every table below belongs to this track.")
     out.append("")

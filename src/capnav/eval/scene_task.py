@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import subprocess
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -97,7 +98,8 @@ def task_key(task: SceneTask, manifest_json: str = "") -> str:
 
 
 def run_scene(task: SceneTask) -> dict[str, Any]:
-    """Run one apartment; returns {"scene_seed", "episodes", "records", "timings", "failures", "map"}.
+    """Run one apartment; returns {"scene_seed", "episodes", "records", "timings", "failures", "map",
+    "commit"} (and "resumed": True when an earlier sitting's result was reused).
 
     The result is saved in the run folder as soon as the apartment is done; a rerun of the same
     task (same settings, same apartment) returns it instead of recomputing, so an interrupted run
@@ -113,15 +115,32 @@ def run_scene(task: SceneTask) -> dict[str, Any]:
             try:
                 old = json.loads(saved.read_text())
                 if old.get("task_key") == key:
-                    return dict(old)
+                    return {**old, "resumed": True}
             except (OSError, json.JSONDecodeError):
                 pass  # unreadable: recompute
         res = _run(task, cfg, out, assets)
     finally:
         assets.sim.close()
     res["task_key"] = key
+    res["commit"] = version_and_commit()[1]  # the code that computed this apartment
     write_json(saved, res)
     return res
+
+
+def version_and_commit() -> tuple[str, str]:
+    """(installed capnav version, short git commit of the source tree or "unknown")."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        v = version("capnav")
+    except PackageNotFoundError:  # pragma: no cover - running from a source tree
+        v = "unknown"
+    try:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                                cwd=Path(__file__).parent, timeout=5).stdout.strip() or "unknown"
+    except (OSError, subprocess.SubprocessError):
+        commit = "unknown"
+    return v, commit
 
 
 def _run(task: SceneTask, cfg: EvalConfig, out: Path, assets: SceneAssets) -> dict[str, Any]:
