@@ -39,8 +39,6 @@ def table1(summaries: Sequence[Summary], protocol: str = "label") -> list[str]:
     """In-a-row success for 1..4 subgoals and independent success, under the paper's rule and the
     strict one; the paper's numbers beside ours only for its own (label-only) protocol."""
     paper_cols = protocol == "label"
-    if protocol == "phrasing":  # one subgoal per episode: no chains to count
-        return _single(summaries, protocol)
     lines = ["| Method | 1 | 2 | 3 | 4 | Indep. | SPL | Strict 1 / 2 / 3 / 4 | Strict indep. "
              + ("| Paper 1 / 2 / 3 / 4 | Paper indep. |" if paper_cols else "|"),
              "|---|---:|---:|---:|---:|---:|---:|---|---:|" + ("---|---:|" if paper_cols else "")]
@@ -178,7 +176,7 @@ def render(summaries: Sequence[Summary], config: Mapping[str, Any],
         out += ["", "## Free phrasings: hand-written instructions (success %)", "",
                 f"Instructions from `{config.get('instructions', 'a file')}`, one subgoal each, judged like the "
                 "description protocol; an absent target succeeds when the method answers 'not found'.", ""]
-        out += table1(summaries, "phrasing")
+        out += _single(summaries, "phrasing")  # one subgoal per episode: no chains to count
         out += standings(summaries, "phrasing")
         if records:
             out += ["", "Successes per kind (paper rule, with the strict count):", ""]
