@@ -206,7 +206,7 @@ class OfflineVerifier(Verifier):
         for w in q.shapes:
             bad = shape_conflict(w, seen)
             if bad is not None:
-                return None, f"'{w}' but its points are {bad}"
+                return None, f"'{w}' while its points are {bad}"
         text = (obj.caption or "").lower()
         agree = float(np.mean([w in seen or w.lower() in text for w in q.shapes]))
         return agree, f"shape {'/'.join(q.shapes)} vs observed {'/'.join(seen) or 'nothing clear'}"
