@@ -2,7 +2,8 @@
 
     .venv/bin/python benchmarks/eval_real_detectors.py --seeds 0 1 2 [--width 640 --height 480]
         [--cache data/bench] [--assets-dir DIR] [--weights ../shared/weights]
-        [--detectors sim yolo-fastest centernet] [--stride 1]
+        [--detectors sim yolo-fastest centernet] [--stride 1] [--depth-noise] [--surface-items]
+        [--json out.json]
 
 Each apartment (``sh3d_data.dataset``: ``capnav sim --furniture sh3d --seed S``, rendered once and
 cached) is mapped once per detector from the same frames (the ``sim`` detector at its default
@@ -15,7 +16,14 @@ that a COCO class maps to (``capnav.perception.coco.TO_CAPNAV``), pooled over th
 - duplicates: map objects beyond the first on the category's instances, over the objects on them;
 - category accuracy: objects on the category's instances that carry its label;
 - size error: median over the category's mapped instances of ``map_quality.size_error`` (the larger
-  of the caption width and height errors of the instance's best object).
+  of the caption width and height errors of the instance's best object), in cm and relative to the
+  truth (``surface_quality.relative_size_error``).
+
+With ``--surface-items`` (``capnav sim --surface-items``: cups, bottles, books, vases, bowls and
+laptops on tables, counters and shelves) a second table scores the small things per kind
+(``capnav.eval.surface_quality``): recall, duplicates, size error, and how often the supporting
+piece's map object absorbed the item (holds points inside it); and per support category how often
+its label went to a thing on it. ``--json`` writes every figure for docs/perception.md.
 
 Truth is read here only (evaluation); the detectors see pixels, depth and poses.
 """
@@ -48,7 +56,7 @@ def make_detector(name: str, weights: Path) -> Any:
 
 
 def score(cmap: Any, manifest: Any, seen: dict[int, int], counts: dict[str, dict[str, float]],
-          sizes: dict[str, list[float]], cats: set[str]) -> None:
+          sizes: dict[str, list[float]], cats: set[str], rel: dict[str, list[float]] | None = None) -> None:
     """Add one map's per-category counts (see the module docstring) to ``counts`` / ``sizes``."""
     from capnav.eval.map_quality import QualityConfig, evaluate_map
 
@@ -68,6 +76,11 @@ def score(cmap: Any, manifest: Any, seen: dict[int, int], counts: dict[str, dict
         counts[c]["dups"] += max(0, len(rec["objects"]) - 1)
         if "size_error" in rec:
             sizes[c].append(float(rec["size_error"]))
+            if rel is not None:
+                from capnav.eval.surface_quality import relative_size_error
+
+                best = max((o for o in cmap.objects if o.id in rec["objects"]), key=lambda o: o.hits)
+                rel[c].append(relative_size_error(best.extent_max - best.extent_min, manifest.object(rec["instance"])))
     labels = {o.id: o.label for o in cmap.objects}
     for oid, c in on_instance.items():
         if c in cats:
@@ -85,6 +98,9 @@ def main() -> None:
                     / "weights")
     ap.add_argument("--detectors", nargs="+", default=["sim", *WEIGHT_FOLDERS], choices=["sim", *WEIGHT_FOLDERS])
     ap.add_argument("--stride", type=int, default=1, help="map every k-th frame")
+    ap.add_argument("--depth-noise", action="store_true", help="render with consumer RGB-D depth noise")
+    ap.add_argument("--surface-items", action="store_true", help="small things on tables, counters and shelves")
+    ap.add_argument("--json", type=Path, default=None, help="write every figure here")
     args = ap.parse_args()
     dataset = importlib.import_module("sh3d_data").dataset  # beside this script
 
@@ -98,8 +114,11 @@ def main() -> None:
                                                       for d in args.detectors}
     sizes: dict[str, dict[str, list[float]]] = {d: defaultdict(list) for d in args.detectors}
     totals: dict[str, dict[str, float]] = {d: defaultdict(float) for d in args.detectors}
+    rel: dict[str, dict[str, list[float]]] = {d: defaultdict(list) for d in args.detectors}
+    surf: dict[str, dict[str, dict[str, Any]]] = {d: {} for d in args.detectors}
     for seed in args.seeds:
-        data = dataset(seed, args.cache, args.width, args.height, "sh3d", args.assets_dir)
+        data = dataset(seed, args.cache, args.width, args.height, "sh3d", args.assets_dir, args.depth_noise,
+                       args.surface_items)
         reader = DatasetReader(data)
         frames = [reader.frame(i) for i in range(0, len(reader), args.stride)]
         manifest = SceneManifest.load(data / "manifest.json")
@@ -111,7 +130,14 @@ def main() -> None:
             totals[name]["frames"] += len(frames)
             totals[name]["objects"] += len(cmap.objects)
             totals[name]["merged"] += int(cmap.meta.get("merged_duplicates", 0))
-            score(cmap, manifest, seen, counts[name], sizes[name], set(cats))
+            score(cmap, manifest, seen, counts[name], sizes[name], set(cats), rel[name])
+            if manifest.items:
+                from capnav.eval.surface_quality import surface_report
+
+                for key, rec in surface_report(cmap, manifest, seen).items():
+                    acc = surf[name].setdefault(key, {})
+                    for f, v in rec.items():
+                        acc[f] = acc.get(f, [] if isinstance(v, list) else 0) + v
             print(f"seed {seed} {name}: {len(cmap.objects)} objects, {len(frames)} frames", flush=True)
 
     def pct(a: float, b: float) -> str:
@@ -125,12 +151,16 @@ def main() -> None:
         for d in args.detectors:
             k = counts[d][c]
             s = sizes[d][c]
+            r = rel[d][c]
             rows.append([c if d == args.detectors[0] else "", d, pct(k["found"], k["seen"]),
                          pct(k["labelled_on"], k["labelled"]), pct(k["dups"], k["on"]), pct(k["right"], k["on"]),
-                         f"{100 * np.median(s):.0f} cm" if s else "-"])
-    table(f"per COCO-covered category, Sweet Home 3D apartments (seeds {' '.join(map(str, args.seeds))}, "
+                         f"{100 * np.median(s):.0f} cm" if s else "-", f"{100 * np.median(r):.0f}%" if r else "-"])
+    scene = ("sh3d" + (", depth noise" if args.depth_noise else "") + (", surface items" if args.surface_items
+                                                                         else ""))
+    table(f"per COCO-covered category, Sweet Home 3D apartments ({scene}; seeds {' '.join(map(str, args.seeds))}, "
            f"{args.width}x{args.height}, every {args.stride}th frame)",
-           ["category", "detector", "recall (seen)", "precision", "duplicates", "category acc.", "size error"], rows)
+           ["category", "detector", "recall (seen)", "precision", "duplicates", "category acc.", "size error",
+            "size error (rel.)"], rows)
     rows = []
     for d in args.detectors:
         t = totals[d]
@@ -142,6 +172,41 @@ def main() -> None:
                      f"{t['frames'] / max(t['seconds'], 1e-9):.1f}"])
     table("all COCO-covered categories pooled", ["detector", "objects", "recall", "precision", "duplicates",
                                                  "category acc.", "merged at export", "frames/s (CPU)"], rows)
+    if any(surf.values()):
+        rows = []
+        for key in sorted({k for d in args.detectors for k in surf[d] if k.startswith("item:")}):
+            for d in args.detectors:
+                k = surf[d].get(key, {})
+                e = k.get("size_errors", [])
+                rows.append([key[5:] if d == args.detectors[0] else "", d, pct(k.get("found", 0), k.get("seen", 0)),
+                             pct(k.get("dups", 0), k.get("on", 0)), f"{100 * np.median(e):.0f}%" if e else "-",
+                             pct(k.get("absorbed", 0), k.get("seen", 0))])
+        table("small things on surfaces, per kind (seen >= 5 frames)",
+              ["item", "detector", "recall", "duplicates", "size error (rel.)", "absorbed by support"], rows)
+        rows = []
+        for key in sorted({k for d in args.detectors for k in surf[d] if k.startswith("support:")}):
+            for d in args.detectors:
+                k = surf[d].get(key, {})
+                rows.append([key[8:] if d == args.detectors[0] else "", d, str(k.get("supports", 0)),
+                             pct(k.get("mapped", 0), k.get("supports", 0)), pct(k.get("outvoted", 0),
+                                                                                k.get("mapped", 0))])
+        table("supports of the small things", ["support", "detector", "with items seen", "mapped",
+                                               "label outvoted by an item"], rows)
+    if args.json is not None:
+        import json
+
+        from capnav.core.atomic import write_text
+
+        blob = {"seeds": args.seeds, "width": args.width, "height": args.height, "stride": args.stride,
+                "depth_noise": args.depth_noise, "surface_items": args.surface_items,
+                "categories": {d: {c: {**counts[d][c], "size_error_cm": float(100 * np.median(sizes[d][c]))
+                                       if sizes[d][c] else None,
+                                       "size_error_rel": float(np.median(rel[d][c])) if rel[d][c] else None}
+                                   for c in cats} for d in args.detectors},
+                "surfaces": {d: {k: {f: (float(np.median(v)) if v else None) if isinstance(v, list) else v
+                                     for f, v in rec.items()} for k, rec in surf[d].items()}
+                             for d in args.detectors}}
+        write_text(args.json, json.dumps(blob, indent=1) + "\n")
 
 
 if __name__ == "__main__":

@@ -16,11 +16,14 @@ from capnav.core.errors import InputError
 
 
 def dataset(seed: int, cache: Path, width: int = 320, height: int = 240, furniture: str = "sh3d",
-            assets_dir: Path | None = None) -> Path:
-    """The cached dataset folder of apartment ``seed`` (rendered on first use)."""
+            assets_dir: Path | None = None, depth_noise: bool = False, surface_items: bool = False) -> Path:
+    """The cached dataset folder of apartment ``seed`` (rendered on first use); ``depth_noise`` and
+    ``surface_items`` (``capnav sim --depth-noise --surface-items``) add ``-noise`` / ``-items``
+    to its name."""
     from capnav.sim.record import record_dataset
 
-    out = Path(cache) / f"{furniture}-s{seed}-{width}x{height}"
+    suffix = ("-noise" if depth_noise else "") + ("-items" if surface_items else "")
+    out = Path(cache) / f"{furniture}-s{seed}-{width}x{height}{suffix}"
     meta = out / "meta.json"
     if meta.is_file():
         try:
@@ -33,5 +36,6 @@ def dataset(seed: int, cache: Path, width: int = 320, height: int = 240, furnitu
     if furniture not in ("sh3d", "primitives"):
         raise InputError(f"furniture must be sh3d or primitives, got {furniture!r}")
     print(record_dataset(seed=seed, out=out, width=width, height=height, furniture=furniture,
-                         assets_dir=assets_dir, progress=False))
+                         assets_dir=assets_dir, progress=False, depth_noise=depth_noise,
+                         surface_items=surface_items))
     return out

@@ -26,6 +26,9 @@ def register(app: typer.Typer) -> None:
         furniture: str = typer.Option("primitives", "--furniture", help="primitives | sh3d (after `capnav assets`)"),
         assets_dir: Path | None = typer.Option(None, "--assets-dir", help="mesh cache of `capnav assets --dir`"),
         depth_noise: bool = typer.Option(False, "--depth-noise", help="consumer RGB-D depth noise (seeded)"),
+        surface_items: bool = typer.Option(False, "--surface-items",
+                                           help="put cups, bottles, books, vases, bowls and laptops on tables, "
+                                                "counters and shelves (in manifest.json with what they stand on)"),
         overwrite: bool = typer.Option(False, "--overwrite", help="replace an existing dataset folder (kept "
                                                                   "until the new one is complete)"),
     ) -> None:
@@ -40,5 +43,5 @@ def register(app: typer.Typer) -> None:
 
         summary = record_dataset(seed=seed, out=out, frames=frames, stride=stride, width=width, height=height,
                                  hfov=hfov, rooms=rooms, furniture=furniture, depth_noise=depth_noise,
-                                 overwrite=overwrite, assets_dir=assets_dir)
+                                 overwrite=overwrite, assets_dir=assets_dir, surface_items=surface_items)
         Console().print(summary, markup=False, highlight=False)

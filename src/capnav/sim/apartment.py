@@ -11,7 +11,7 @@ from capnav.core.categories import BY_NAME
 from capnav.core.errors import InputError
 from capnav.sim.config import SimConfig
 from capnav.sim.layout import FloorPlan, Rect, generate_floorplan
-from capnav.sim.manifest import Door, ObjectInstance, Room, SceneManifest
+from capnav.sim.manifest import Door, ItemInstance, ObjectInstance, Room, SceneManifest
 from capnav.sim.navgrid import NavGrid
 from capnav.sim.palette import (
     CATEGORY_STYLE,
@@ -80,6 +80,7 @@ class Apartment:
     wall_faces: list[WallFace]
     floor_styles: list[tuple[str, RGB]]
     wall_colors: list[RGB]
+    items: list[SceneObject] = field(default_factory=list)  # small things on furniture (opt-in, surface_items)
     manifest: SceneManifest = field(init=False)
 
     def __post_init__(self) -> None:
@@ -324,6 +325,11 @@ def _manifest(apt: Apartment) -> SceneManifest:
         zip(plan.rooms, plan.types, strict=True))]
     doors = [Door(rooms=(room_ids[d.rooms[0]], room_ids[d.rooms[1]]), center=d.center, width=d.width)
              for d in plan.doors]
+    items = [ItemInstance(
+        id=o.id, category=o.category, color_name=o.color_name, size=o.model.size,
+        center=(o.x, o.y, float(getattr(o, "base", 0.0)) + o.model.size[2] / 2), yaw=float(o.yaw),
+        footprint=[(float(x), float(y)) for x, y in o.footprint()], room=room_ids[o.room],
+        support=int(getattr(o, "support", 0))) for o in apt.items]
     b: Rect = plan.bounds
     return SceneManifest(seed=apt.seed, bounds=(b.x0, b.y0, b.x1, b.y1), wall_height=apt.config.layout.wall_height,
-                         rooms=rooms, doors=doors, objects=objs)
+                         rooms=rooms, doors=doors, objects=objs, items=items or None)

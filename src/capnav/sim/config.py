@@ -113,6 +113,9 @@ class FurnishConfig:
     count_scale: float = 1.0  # multiplies each room plan's maximum count of a category
     near_color_prob: float = 0.0  # chance that another instance of a category takes a shade of an earlier colour
     clutter_per_room: tuple[int, int] = (0, 0)  # small pieces (plants, stools, ottomans) in front of furniture
+    # Small things (cups, bottles, books, vases, bowls, laptops) on each table, counter and shelf
+    # piece: (min, max) per piece; (0, 0) places none (``capnav.sim.surface_items``).
+    surface_items: tuple[int, int] = (0, 0)
     # Generation speed in big houses: a furnishing that loses at most ``accept_lost`` objects to the
     # reachability check is kept at once, and that check drops ``prune_batch`` objects per pass.
     max_per_category: int | None = None  # at most this many instances of one category in the house
@@ -127,6 +130,9 @@ class FurnishConfig:
         lo, hi = self.clutter_per_room
         if not (0 <= lo <= hi <= 6):
             raise InputError(f"clutter_per_room must satisfy 0 <= lo <= hi <= 6, got {self.clutter_per_room}")
+        lo, hi = self.surface_items
+        if not (0 <= lo <= hi <= 8):
+            raise InputError(f"surface_items must satisfy 0 <= lo <= hi <= 8, got {self.surface_items}")
 
 
 @dataclass(frozen=True)

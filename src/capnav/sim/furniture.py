@@ -23,8 +23,14 @@ FURNITURE: Registry[Apartment] = Registry("furniture source")
 
 
 def furnish(apt: Apartment, config: SimConfig) -> Apartment:
-    """Apply ``config.furniture`` (a FURNITURE registry name) to a generated apartment."""
-    return FURNITURE.create(config.furniture, apt=apt, config=config)
+    """Apply ``config.furniture`` (a FURNITURE registry name) to a generated apartment, then put
+    the opt-in small things on its surfaces (``FurnishConfig.surface_items``)."""
+    apt = FURNITURE.create(config.furniture, apt=apt, config=config)
+    if config.furnish.surface_items[1] > 0:
+        from capnav.sim.surface_items import place_surface_items
+
+        place_surface_items(apt, config.furnish.surface_items)
+    return apt
 
 
 @FURNITURE.register("primitives")

@@ -7,8 +7,9 @@ The mapping, captioning and retrieval pipeline never reads it. Versioned; saved 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
-from pydantic import BaseModel, Field, ValidationError
+from pydantic import BaseModel, Field, SerializerFunctionWrapHandler, ValidationError, model_serializer
 
 from capnav.core.atomic import write_text
 from capnav.core.errors import DatasetError
@@ -39,6 +40,23 @@ class ObjectInstance(BaseModel):
     license: str = "CC0-1.0"
 
 
+class ItemInstance(BaseModel):
+    """A small thing standing on a piece of furniture (``capnav sim --surface-items``). Its
+    ``category`` is a COCO class name (cup, bottle, book, vase, bowl, laptop), not a CapNav
+    category; ``support`` is the id of the object it stands on. ``id`` is its instance id in
+    ``gt_instance`` (after the objects' ids)."""
+
+    id: int = Field(ge=1)
+    category: str
+    color_name: str
+    size: Vec3 = Field(description="extent (m) along the item's local x, y, z axes")
+    center: Vec3
+    yaw: float
+    footprint: list[Vec2]
+    room: str
+    support: int = Field(ge=1, description="id of the object it stands on")
+
+
 class Room(BaseModel):
     id: str
     name: str = Field(description="room type: living room, kitchen, bedroom, bathroom, office, hallway")
@@ -60,6 +78,14 @@ class SceneManifest(BaseModel):
     rooms: list[Room]
     doors: list[Door] = []
     objects: list[ObjectInstance]
+    items: list[ItemInstance] | None = None  # absent from the file unless the scene has items
+
+    @model_serializer(mode="wrap")
+    def _without_empty_items(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        data: dict[str, Any] = handler(self)
+        if data.get("items") is None:
+            data.pop("items", None)  # default scenes keep their manifest bytes (and cache keys)
+        return data
 
     def object(self, instance_id: int) -> ObjectInstance:
         for o in self.objects:

@@ -19,10 +19,13 @@ from capnav.sim.simulator import Simulator
 def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride: int = 1, width: int = 320,
                    height: int = 240, hfov: float = 90.0, rooms: int | None = None, furniture: str = "primitives",
                    depth_noise: bool = False, overwrite: bool = False, progress: bool = True,
-                   config: SimConfig | None = None, assets_dir: str | Path | None = None) -> str:
+                   config: SimConfig | None = None, assets_dir: str | Path | None = None,
+                   surface_items: bool = False) -> str:
     """Build apartment ``seed``, render its exploration pass into ``out``; returns a one-line summary.
 
     Writes ``out/manifest.json`` (scene truth, for evaluation) and ``out/topdown.png`` beside the frames.
+    ``surface_items`` puts 1-3 small things (cups, books, a laptop...) on each table, counter and
+    shelf piece (``capnav.sim.surface_items``); the apartment's furniture stays the same.
     """
     from capnav.viz.scene import draw_scene
 
@@ -34,12 +37,16 @@ def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride
                   layout=LayoutConfig(rooms=rooms) if rooms is not None else base.layout,
                   depth_noise=DepthNoiseConfig(enabled=True, seed=seed) if depth_noise else base.depth_noise,
                   furniture=furniture, assets_dir=str(assets_dir) if assets_dir is not None else base.assets_dir)
+    if surface_items:
+        cfg = replace(cfg, furnish=replace(cfg.furnish, surface_items=(1, 3)))
     t0 = time.perf_counter()
     with Simulator.from_seed(seed, cfg) as sim:
         t_build = time.perf_counter() - t0
         poses = plan_exploration(sim, ExploreConfig(seed=seed, stride=stride, max_frames=frames))
         meta = {"source": "capnav.sim", "seed": seed, "furniture": furniture, "rooms": len(sim.manifest.rooms),
                 "objects": len(sim.manifest.objects), "depth_noise": depth_noise, "exploration": "capnav.sim.explore"}
+        if sim.manifest.items:  # only then: default datasets keep their meta.json bytes
+            meta["surface_items"] = len(sim.manifest.items)
         t1 = time.perf_counter()
         # Built in a temporary sibling and swapped in whole: an interrupted --overwrite keeps the old one.
         with atomic_dir(out, overwrite=overwrite) as tmp:

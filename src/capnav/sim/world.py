@@ -106,6 +106,10 @@ class BulletWorld:
                 uid = self._build_object(o)
                 uid_to_instance[uid] = (o.id, BY_NAME[o.category].id)
                 self.room_bodies[o.room].append(uid)
+            for it in apt.items:  # small things on furniture: instance ids, no CapNav category
+                uid = self._build_object(it)
+                uid_to_instance[uid] = (it.id, 0)
+                self.room_bodies[it.room].append(uid)
             self._build_structure(apt)
         except Exception:
             self.close()
