@@ -29,12 +29,34 @@ def register(app: typer.Typer) -> None:
         surface_items: bool = typer.Option(False, "--surface-items",
                                            help="put cups, bottles, books, vases, bowls and laptops on tables, "
                                                 "counters and shelves (in manifest.json with what they stand on)"),
+        visit: int = typer.Option(1, "--visit", min=1, max=100,
+                                  help="1: the apartment as generated; 2 or more: the same apartment after "
+                                       "--changes (listed in manifest.json with old and new poses)"),
+        changes: str = typer.Option("moved=3,removed=2,added=2", "--changes",
+                                    help="changes of a later --visit: moved=N,removed=N,added=N"),
+        change_seed: int = typer.Option(0, "--change-seed", min=0, help="seed of the changes (default 0)"),
+        frame_offset: str | None = typer.Option(
+            None, "--frame-offset", metavar="X,Y,YAW",
+            help="write the poses in a world frame shifted by X,Y metres and turned YAW degrees (a robot "
+                 "started elsewhere on another day; `capnav map --update` registers the recordings)"),
         overwrite: bool = typer.Option(False, "--overwrite", help="replace an existing dataset folder (kept "
                                                                   "until the new one is complete)"),
     ) -> None:
         """Write a posed RGB-D dataset (with manifest.json and topdown.png) for one apartment."""
         from rich.console import Console
 
+        from capnav.core.errors import InputError
+        from capnav.sim.changes import ChangeSpec
+
+        spec = ChangeSpec.parse(changes) if visit > 1 else None
+        offset = None
+        if frame_offset is not None:
+            try:
+                ox, oy, oyaw = (float(v) for v in frame_offset.split(","))
+            except ValueError:
+                raise InputError(f"--frame-offset must be X,Y,YAW (metres, metres, degrees), got "
+                                 f"{frame_offset!r}") from None
+            offset = (ox, oy, oyaw)
         check_output_dir(out, "--out", must_be_empty=True, overwrite=overwrite)
         on_interrupt(f"{out} was left as it was (the new dataset is built beside it and swapped in only when "
                      "complete)")
@@ -43,5 +65,7 @@ def register(app: typer.Typer) -> None:
 
         summary = record_dataset(seed=seed, out=out, frames=frames, stride=stride, width=width, height=height,
                                  hfov=hfov, rooms=rooms, furniture=furniture, depth_noise=depth_noise,
-                                 overwrite=overwrite, assets_dir=assets_dir, surface_items=surface_items)
+                                 overwrite=overwrite, assets_dir=assets_dir, surface_items=surface_items,
+                                 visit=visit, changes=spec,
+                                 change_seed=change_seed, frame_offset=offset)
         Console().print(summary, markup=False, highlight=False)

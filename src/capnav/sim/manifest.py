@@ -57,6 +57,18 @@ class ItemInstance(BaseModel):
     support: int = Field(ge=1, description="id of the object it stands on")
 
 
+class ObjectChange(BaseModel):
+    """One change between visit 1 and a later visit; poses are (x, y, yaw) in the apartment frame."""
+
+    kind: str = Field(description="moved | removed | added")
+    id: int = Field(ge=1, description="manifest id (the same object keeps its id across visits)")
+    category: str
+    old_pose: Vec3 | None = None
+    new_pose: Vec3 | None = None
+    old_room: str | None = None
+    new_room: str | None = None
+
+
 class Room(BaseModel):
     id: str
     name: str = Field(description="room type: living room, kitchen, bedroom, bathroom, office, hallway")
@@ -79,12 +91,19 @@ class SceneManifest(BaseModel):
     doors: list[Door] = []
     objects: list[ObjectInstance]
     items: list[ItemInstance] | None = None  # absent from the file unless the scene has items
+    visit: int = Field(default=1, ge=1, description="1 = the apartment as generated; later visits hold `changes`")
+    changes: list[ObjectChange] = []
+    frame_offset: tuple[float, float, float] | None = Field(
+        default=None, description="(x, y, yaw) of the recording's world frame in the apartment frame, when offset")
 
     @model_serializer(mode="wrap")
     def _without_empty_items(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
         data: dict[str, Any] = handler(self)
         if data.get("items") is None:
             data.pop("items", None)  # default scenes keep their manifest bytes (and cache keys)
+        if data.get("visit") == 1 and data.get("frame_offset") is None:  # and so do first visits
+            for k in ("visit", "changes", "frame_offset"):
+                data.pop(k, None)
         return data
 
     def object(self, instance_id: int) -> ObjectInstance:

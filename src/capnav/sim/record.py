@@ -5,8 +5,10 @@ from __future__ import annotations
 import time
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from capnav.core.atomic import atomic_dir
 from capnav.core.progress import track
@@ -15,15 +17,32 @@ from capnav.sim.config import CameraConfig, DepthNoiseConfig, LayoutConfig, SimC
 from capnav.sim.explore import ExploreConfig, plan_exploration
 from capnav.sim.simulator import Simulator
 
+if TYPE_CHECKING:
+    from capnav.sim.changes import ChangeSpec
+
+
+def planar_pose(x: float, y: float, yaw: float) -> NDArray[np.float64]:
+    """4x4 rigid transform: a rotation ``yaw`` (rad) about z, then a shift (x, y)."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    T = np.eye(4)
+    T[:2, :2] = [[c, -s], [s, c]]
+    T[0, 3], T[1, 3] = x, y
+    return T
+
 
 def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride: int = 1, width: int = 320,
                    height: int = 240, hfov: float = 90.0, rooms: int | None = None, furniture: str = "primitives",
                    depth_noise: bool = False, overwrite: bool = False, progress: bool = True,
-                   config: SimConfig | None = None, assets_dir: str | Path | None = None,
+                   config: SimConfig | None = None, assets_dir: str | Path | None = None, visit: int = 1,
+                   changes: ChangeSpec | None = None, change_seed: int = 0,
+                   frame_offset: tuple[float, float, float] | None = None,
                    surface_items: bool = False) -> str:
     """Build apartment ``seed``, render its exploration pass into ``out``; returns a one-line summary.
 
     Writes ``out/manifest.json`` (scene truth, for evaluation) and ``out/topdown.png`` beside the frames.
+    ``visit`` > 1 records the apartment after ``changes`` (seeded by ``change_seed``); ``frame_offset``
+    (x, y, yaw in degrees: where the recording's world frame lies in the apartment's) writes the poses
+    in another world frame, as a robot started elsewhere on another day would.
     ``surface_items`` puts 1-3 small things (cups, books, a laptop...) on each table, counter and
     shelf piece (``capnav.sim.surface_items``); the apartment's furniture stays the same.
     """
@@ -40,23 +59,34 @@ def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride
     if surface_items:
         cfg = replace(cfg, furnish=replace(cfg.furnish, surface_items=(1, 3)))
     t0 = time.perf_counter()
-    with Simulator.from_seed(seed, cfg) as sim:
+    with Simulator.from_seed(seed, cfg, visit=visit, changes=changes, change_seed=change_seed) as sim:
         t_build = time.perf_counter() - t0
         poses = plan_exploration(sim, ExploreConfig(seed=seed, stride=stride, max_frames=frames))
         meta = {"source": "capnav.sim", "seed": seed, "furniture": furniture, "rooms": len(sim.manifest.rooms),
                 "objects": len(sim.manifest.objects), "depth_noise": depth_noise, "exploration": "capnav.sim.explore"}
         if sim.manifest.items:  # only then: default datasets keep their meta.json bytes
             meta["surface_items"] = len(sim.manifest.items)
+        if visit > 1:  # what a robot knows of its own recording: which visit (day) it is
+            meta["visit"] = visit
+        to_rec: NDArray[np.float64] = np.eye(4)
+        if frame_offset is not None:
+            ox, oy, oyaw = frame_offset
+            sim.manifest.frame_offset = (float(ox), float(oy), float(oyaw))
+            to_rec = np.asarray(np.linalg.inv(planar_pose(ox, oy, np.radians(oyaw))), dtype=np.float64)
         t1 = time.perf_counter()
         # Built in a temporary sibling and swapped in whole: an interrupted --overwrite keeps the old one.
         with atomic_dir(out, overwrite=overwrite) as tmp:
             with DatasetWriter(tmp, sim.intrinsics, meta) as writer:
                 for i, T in enumerate(track(poses, f"rendering seed {seed}", enabled=progress)):
-                    writer.write(sim.render(T, index=i))
+                    f = sim.render(T, index=i)
+                    if frame_offset is not None:
+                        f = replace(f, T_wc=to_rec @ f.T_wc)
+                    writer.write(f)
             t_render = time.perf_counter() - t1
             sim.manifest.save(tmp / "manifest.json")
             traj = np.array([T[:2, 3] for T in poses]) if poses else None
             draw_scene(sim.manifest, tmp / "topdown.png", navigable=sim.navigable(), trajectory=traj)
-        return (f"wrote {len(poses)} frames ({width}x{height}) of apartment seed {seed} "
+        what = f"visit {visit} ({changes}) of " if visit > 1 else ""
+        return (f"wrote {len(poses)} frames ({width}x{height}) of {what}apartment seed {seed} "
                 f"({len(sim.manifest.rooms)} rooms, {len(sim.manifest.objects)} objects) to {out} "
                 f"[build {t_build:.2f} s, render+write {t_render:.1f} s]")
