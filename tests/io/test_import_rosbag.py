@@ -242,7 +242,7 @@ def test_cli(tmp_path: Path, frames: list[Frame]) -> None:
                                    "--info-topic", "/camera/color/camera_info", "--pose-topic", "/odom",
                                    "--camera-in-body", EXTRINSIC, "--no-progress"])
     assert res.exit_code == 0, res.output
-    assert "3 frames written from a rosbag recording" in res.output and "up found: the recording's" in res.output
+    assert "3 frames written from the rosbag recording" in res.output and "up found: the recording's" in res.output
     assert "deg from +z; confidence 1.00" in res.output  # the bag's world is z up: found without --up
     _check(tmp_path / "ds", frames[:3])
 

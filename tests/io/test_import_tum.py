@@ -108,13 +108,12 @@ def test_up_none_keeps_recording_frame(tmp_path: Path, frames: list[Frame]) -> N
 
 def test_no_pose_and_stride(tmp_path: Path, frames: list[Frame]) -> None:
     write_tum(tmp_path / "seq", frames, gt_end=4)  # ground truth stops after frame 3 (at +0.31 s)
-    rec = TumReader(tmp_path / "seq", "fr1")  # preset intrinsics are 640x480: every frame has a bad size
+    with pytest.raises(InputError, match=r"intrinsics \(fr1\) are for 640x480 but the colour image .* is 160x120"):
+        TumReader(tmp_path / "seq", "fr1")  # the preset is another camera's: refused before anything is read
+    rec = TumReader(tmp_path / "seq")  # cam.json beside rgb.txt is read by default
+    assert rec.meta["intrinsics_source"].endswith("cam.json")
     assert rec.skipped.counts() == {"no pose": 2}
     assert "outside the pose stamps" in rec.skipped.skips[0].detail
-    with pytest.raises(InputError, match=r"every selected frame was skipped .*bad size"):
-        import_recording(rec, tmp_path / "ds", up="none", progress=False)
-    assert not (tmp_path / "ds").exists() and [p.name for p in tmp_path.iterdir()] == ["seq"]
-    rec = TumReader(tmp_path / "seq", tmp_path / "seq" / "cam.json")
     rep = import_recording(rec, tmp_path / "ds", up="-y", stride=2, max_frames=1, progress=False)
     assert rep.selected == 1 and len(DatasetReader(tmp_path / "ds")) == 1
 
@@ -137,25 +136,26 @@ def test_interpolation_and_association_units() -> None:
 def test_errors_name_the_file_and_line(tmp_path: Path, frames: list[Frame]) -> None:
     seq = tmp_path / "seq"
     write_tum(seq, frames[:2])
+    cam = (seq / "cam.json").rename(tmp_path / "cam.json")
     with pytest.raises(InputError, match="cannot tell the camera"):
         TumReader(seq)
     gt = (seq / "groundtruth.txt").read_text()
     (seq / "groundtruth.txt").write_text(gt + "1305031102.5 1 2 3 0 0 0\n")
     with pytest.raises(InputError, match=r"groundtruth.txt line 6: expected 8 fields"):
-        TumReader(seq, "fr2")
+        TumReader(seq, cam)
     (seq / "groundtruth.txt").write_text(gt + "1305031102.5 1 2 3 0 0 0 2\n")
     with pytest.raises(PoseError, match=r"groundtruth.txt line 6: not a rigid pose: quaternion norm 2"):
-        TumReader(seq, "fr2")
+        TumReader(seq, cam)
     (seq / "groundtruth.txt").write_text(gt.replace("1305031102.0", "13050311O2.0", 1))
     with pytest.raises(InputError, match="not a number"):
-        TumReader(seq, "fr2")
+        TumReader(seq, cam)
     (seq / "groundtruth.txt").write_text(gt)
     next((seq / "depth").iterdir()).unlink()
     with pytest.raises(InputError, match=r"1 listed images are missing, e.g. .*depth/"):
-        TumReader(seq, "fr2")
+        TumReader(seq, cam)
     (seq / "depth.txt").unlink()
     with pytest.raises(InputError, match=r"missing depth list file: .*depth.txt"):
-        TumReader(seq, "fr2")
+        TumReader(seq, cam)
     with pytest.raises(InputError, match="not found"):
         TumReader(tmp_path / "nope", "fr1")
 

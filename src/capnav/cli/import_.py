@@ -1,7 +1,9 @@
-"""``capnav import tum|rosbag SRC -o DATASET``: bring a recording into a ``capnav-rgbd`` folder.
+"""``capnav import auto|tum|open3d|3dmatch|scannet|rosbag SRC -o DATASET``: bring a recording into a
+``capnav-rgbd`` folder.
 
-The recording's world frame is aligned to CapNav's (z up, floor at z = 0) from the floor seen in
-depth; every skipped frame is counted with its reason.
+``auto`` recognises the layout from its files and says which it is. The recording's world frame is
+aligned to CapNav's (z up, floor at z = 0) from the floor seen in depth; every skipped frame is
+counted with its reason.
 """
 
 from __future__ import annotations
@@ -26,11 +28,15 @@ Up = Annotated[str, typer.Option("--up", help="'auto' finds up from the floor an
                                               "keeps the recorded frame")]
 Overwrite = Annotated[bool, typer.Option("--overwrite", help="replace an existing dataset folder")]
 Progress = Annotated[bool, typer.Option(help="show progress")]
+Intrinsics = Annotated[str | None, typer.Option("--intrinsics", help="intrinsics file (default: the layout's own)")]
+DepthScale = Annotated[float | None, typer.Option("--depth-scale", help="depth PNG units per metre (default: the "
+                                                                        "layout's: 5000 TUM, 1000 the others)")]
 
 
 def _import(reader: Callable[[], Recording], out: Path, up: str, stride: int, max_frames: int | None,
-            overwrite: bool, progress: bool) -> None:
-    """Check ``--up`` before opening the recording, import it, print what was kept and skipped."""
+            overwrite: bool, progress: bool, said: Callable[[Recording], str] | None = None) -> None:
+    """Check ``--up`` before opening the recording, import it, print what was kept and skipped
+    (``said``: a first line about the recording, e.g. which layout was recognised)."""
     from rich.console import Console
 
     from capnav.cli.options import check_output_dir, on_interrupt
@@ -40,16 +46,82 @@ def _import(reader: Callable[[], Recording], out: Path, up: str, stride: int, ma
     check_output_dir(out, "--out", must_be_empty=True, overwrite=overwrite)
     parse_up(up)
     on_interrupt(f"{out} was left as it was (the dataset is built beside it and swapped in only when complete)")
-    report = import_recording(reader(), out, up=up, stride=stride, max_frames=max_frames, overwrite=overwrite,
-                              progress=progress)
     con = Console(stderr=True, soft_wrap=True)
+    rec = reader()
+    if said is not None:
+        con.print(said(rec), highlight=False, markup=False)
+    report = import_recording(rec, out, up=up, stride=stride, max_frames=max_frames, overwrite=overwrite,
+                              progress=progress)
     for line in report.lines():
         con.print(line, style="yellow" if line.startswith("skipped") else None, highlight=False, markup=False)
 
 
 def register(app: typer.Typer) -> None:
-    imp = typer.Typer(help="Import a recording (TUM RGB-D folder, ROS1/ROS2 bag) as a capnav-rgbd dataset folder.",
-                      no_args_is_help=True)
+    imp = typer.Typer(help="Import a recording (TUM RGB-D, Open3D, 3DMatch, ScanNet, ROS1/ROS2 bag) as a "
+                           "capnav-rgbd dataset folder; 'auto' recognises the layout.", no_args_is_help=True)
+
+    @imp.command("auto")
+    def auto_cmd(
+        src: Annotated[Path, typer.Argument(help="recording folder of any known layout")],
+        out: Out,
+        intrinsics: Intrinsics = None, depth_scale: DepthScale = None, stride: Stride = 1,
+        max_frames: MaxFrames = None, up: Up = "auto", overwrite: Overwrite = False, progress: Progress = True,
+    ) -> None:
+        """Recognise the layout of SRC (TUM, Open3D, 3DMatch, ScanNet) from its files and import it with that
+        layout's defaults (its depth scale, its intrinsics file)."""
+        from capnav.io.layouts import open_recording
+
+        found: dict[str, str] = {}
+
+        def open_it() -> Recording:
+            rec, lay, ev = open_recording(src, intrinsics=intrinsics, depth_scale=depth_scale)
+            found["line"] = (f"{src}: {lay.name} layout ({ev}); intrinsics {rec.meta.get('intrinsics_source')}, "
+                             f"depth {rec.meta.get('depth_scale_in'):g} units per metre")
+            return rec
+
+        _import(open_it, out, up, stride, max_frames, overwrite, progress, said=lambda _: found["line"])
+
+    @imp.command("open3d")
+    def open3d_cmd(
+        src: Annotated[Path, typer.Argument(help="folder with image/ (or color/), depth/, trajectory.log")],
+        out: Out,
+        intrinsics: Intrinsics = None, depth_scale: DepthScale = None,
+        fps: float = typer.Option(30.0, "--fps", help="frame rate (the layout has no timestamps)"),
+        trajectory: Path | None = typer.Option(None, "--trajectory", help="the trajectory log, if not SRC/*.log"),
+        stride: Stride = 1, max_frames: MaxFrames = None, up: Up = "auto", overwrite: Overwrite = False,
+        progress: Progress = True,
+    ) -> None:
+        """Import an Open3D / Redwood reconstruction-system folder (camera-to-world log, depth in mm)."""
+        from capnav.io.open3d_log import DEPTH_SCALE, Open3dReader
+
+        _import(lambda: Open3dReader(src, intrinsics, depth_scale=depth_scale or DEPTH_SCALE, fps=fps,
+                                     trajectory=trajectory), out, up, stride, max_frames, overwrite, progress)
+
+    @imp.command("3dmatch")
+    def threedmatch_cmd(
+        src: Annotated[Path, typer.Argument(help="scene folder (camera-intrinsics.txt, seq-*/) or one sequence")],
+        out: Out,
+        intrinsics: Intrinsics = None, depth_scale: DepthScale = None, stride: Stride = 1,
+        max_frames: MaxFrames = None, up: Up = "auto", overwrite: Overwrite = False, progress: Progress = True,
+    ) -> None:
+        """Import a 3DMatch / 7-Scenes scene (frame-XXXXXX.color/.depth/.pose files, depth in mm)."""
+        from capnav.io.threedmatch import DEPTH_SCALE, ThreeDMatchReader
+
+        _import(lambda: ThreeDMatchReader(src, intrinsics, depth_scale=depth_scale or DEPTH_SCALE),
+                out, up, stride, max_frames, overwrite, progress)
+
+    @imp.command("scannet")
+    def scannet_cmd(
+        src: Annotated[Path, typer.Argument(help="exported frames: color/, depth/, pose/, intrinsic/")],
+        out: Out,
+        depth_scale: DepthScale = None, stride: Stride = 1,
+        max_frames: MaxFrames = None, up: Up = "auto", overwrite: Overwrite = False, progress: Progress = True,
+    ) -> None:
+        """Import ScanNet's exported frames (written at the depth camera's resolution, colour resampled)."""
+        from capnav.io.scannet import DEPTH_SCALE, ScannetReader
+
+        _import(lambda: ScannetReader(src, depth_scale=depth_scale or DEPTH_SCALE),
+                out, up, stride, max_frames, overwrite, progress)
 
     @imp.command("tum")
     def tum_cmd(

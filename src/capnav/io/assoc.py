@@ -97,6 +97,12 @@ def poses_from_quat(t: NDArray[np.floating], xyz: NDArray[np.floating], quat_xyz
     return T
 
 
+def check_gap(max_gap: float) -> None:
+    """``--max-pose-gap`` is a duration: a negative one would silently drop every frame."""
+    if not (max_gap >= 0 and np.isfinite(max_gap)):
+        raise InputError(f"--max-pose-gap must be a number of seconds >= 0, got {max_gap}")
+
+
 class PoseTrack:
     """Poses at irregular stamps, interpolated in between (linear translation, slerp rotation).
 
@@ -123,6 +129,7 @@ class PoseTrack:
         """Poses at ``t`` (N, 4, 4), a mask of which exist, and the reason for each missing one ('' if ok)."""
         from scipy.spatial.transform import Rotation, Slerp
 
+        check_gap(max_gap)
         t = np.asarray(t, dtype=np.float64)
         s = self.stamps
         out = np.tile(np.eye(4), (t.size, 1, 1))

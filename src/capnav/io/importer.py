@@ -35,6 +35,7 @@ class PlannedFrame:
     T_wc: NDArray[np.float64]  # in the recording's world
     rgb: Any  # the reader's handle for the colour image
     depth: Any  # ... and for the depth image
+    source_index: int = -1  # the frame's number in the recording (its order in the source)
 
 
 class Recording(Protocol):
@@ -68,7 +69,7 @@ class ImportReport:
     def lines(self) -> list[str]:
         """Human summary: what was written, how the world was aligned, and every skip reason with examples."""
         a = self.alignment.info
-        out = [f"{self.out}: {self.written} frames written from a {self.kind} recording "
+        out = [f"{self.out}: {self.written} frames written from the {self.kind} recording "
                f"({self.associated} associated, {self.selected} selected) in {self.seconds:.1f} s"]
         if a.get("method") in ("floor-auto", "floor-named"):
             how = ("up found" if a["method"] == "floor-auto" else
@@ -119,6 +120,7 @@ def import_recording(rec: Recording, out: str | Path, up: str = "auto", stride: 
     n_before = len(rec.skipped.skips)  # the reader counts frames it cannot load while they are written
     meta: dict[str, Any] = {"source": rec.kind, "recording": str(rec.path), **rec.meta,
                             "alignment": align.to_meta()}
+    sources: list[list[Any]] = []  # per written frame: where it came from
     with atomic_dir(out, overwrite=True) as tmp:  # the target was checked above
         w = DatasetWriter(tmp, rec.K, meta, write_gt=False)
         for f, rgb, depth in track(rec.load(frames), f"importing {rec.path.name}", total=len(frames),
@@ -133,13 +135,15 @@ def import_recording(rec: Recording, out: str | Path, up: str = "auto", stride: 
                 skipped.add(f.name, f.timestamp, "no valid depth", "every depth pixel is 0 or non-finite")
                 continue
             depth = np.where(valid, depth, 0.0).astype(np.float32)
+            sources.append([len(w), f.source_index, f.timestamp, f.name])
             w.write(Frame(index=len(w), rgb=rgb, depth=depth, K=rec.K, T_wc=align.A @ f.T_wc, timestamp=f.timestamp))
         skipped.skips.extend(rec.skipped.skips[n_before:])
         if len(w) == 0:
             raise InputError(f"{rec.path}: every selected frame was skipped ({skipped.counts()})")
         w.meta["import"] = {"associated": len(rec.frames), "selected": len(frames), "written": len(w),
                             "skipped": skipped.counts(),
-                            "skipped_examples": {r: [s.name for s in skipped.examples(r)] for r in skipped.counts()}}
+                            "skipped_examples": {r: [s.name for s in skipped.examples(r)] for r in skipped.counts()},
+                            "frames_columns": ["index", "source_index", "timestamp", "name"], "frames": sources}
         w.close()
     return ImportReport(out, rec.kind, len(rec.frames), len(frames), w.meta["import"]["written"], skipped, align,
                         time.monotonic() - t0, meta)

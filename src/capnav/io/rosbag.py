@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from capnav.core.errors import InputError
 from capnav.core.geometry import Intrinsics
-from capnav.io.assoc import PoseTrack, SkipLog, match_nearest, poses_from_quat
+from capnav.io.assoc import PoseTrack, SkipLog, check_gap, match_nearest, poses_from_quat
 from capnav.io.importer import PlannedFrame
 
 IMAGE = "sensor_msgs/msg/Image"
@@ -129,6 +129,7 @@ class RosbagReader:
             raise InputError(f"bag not found: {self.path}")
         if not max_dt > 0:
             raise InputError(f"--max-dt must be > 0 s, got {max_dt}")
+        check_gap(max_pose_gap)
         self.topics = {"rgb": rgb_topic, "depth": depth_topic, "info": info_topic, "pose": pose_topic}
         if rgb_topic == depth_topic:
             raise InputError(f"--rgb-topic and --depth-topic are the same topic {rgb_topic!r}")
@@ -185,7 +186,7 @@ class RosbagReader:
             elif not has_pose[i]:
                 self.skipped.add(name, t["rgb"][i], "no pose", why[i])
             else:
-                self.frames.append(PlannedFrame(name, float(t["rgb"][i]), poses[i], i, int(j[i])))
+                self.frames.append(PlannedFrame(name, float(t["rgb"][i]), poses[i], i, int(j[i]), i))
         self.meta: dict[str, Any] = {
             "topics": self.topics, "message_types": self.msgtypes, "stamps": self.stamp_source,
             "camera_in_body": None if T_bc is None else [float(v) for v in T_bc.reshape(-1)],

@@ -14,7 +14,6 @@ ground-truth pose interpolated at the colour stamp (``capnav.io.assoc``).
 
 from __future__ import annotations
 
-import json
 import re
 from collections.abc import Iterator
 from pathlib import Path
@@ -26,9 +25,10 @@ from PIL import Image
 
 from capnav.core.errors import InputError
 from capnav.core.geometry import Intrinsics
-from capnav.io.assoc import PoseTrack, SkipLog, match_nearest, poses_from_quat
+from capnav.io.assoc import PoseTrack, SkipLog, check_gap, match_nearest, poses_from_quat
 from capnav.io.depth_formats import read_png16
 from capnav.io.importer import PlannedFrame
+from capnav.io.intrinsics import check_fit, image_size, read_json
 
 #: Published calibration of the three Kinects of the benchmark (640x480), from the dataset's
 #: "File Formats" page, section "Intrinsic Camera Calibration of the Kinect":
@@ -40,6 +40,7 @@ FREIBURG: dict[str, Intrinsics] = {
     "fr3": Intrinsics(fx=535.4, fy=539.2, cx=320.1, cy=247.6, width=640, height=480),
 }
 DEPTH_SCALE = 5000.0  # TUM depth PNG units per metre
+CAM_JSON = "cam.json"  # intrinsics beside rgb.txt, read when --intrinsics is not given
 MAX_DT = 0.02  # seconds, as the benchmark's associate.py
 MAX_POSE_GAP = 0.5  # seconds between the ground-truth stamps around a frame
 
@@ -68,11 +69,13 @@ def read_list(path: Path, columns: int, what: str) -> list[list[str]]:
 
 def load_intrinsics(spec: str | Path | Intrinsics | None, root: Path,
                     first_rgb: Path | None = None) -> tuple[Intrinsics, str]:
-    """``fr1``/``fr2``/``fr3``, a JSON file ``{"fx", "fy", "cx", "cy"[, "width", "height"]}`` (without a
-    size the first colour image gives it), or None to take the preset of a folder named like
-    ``rgbd_dataset_freiburg2_desk``. Returns the intrinsics and where they came from."""
+    """``fr1``/``fr2``/``fr3``, a JSON file (``capnav.io.intrinsics``; without a size the first colour
+    image gives it), or None to read ``cam.json`` beside ``rgb.txt``, else take the preset of a folder
+    named like ``rgbd_dataset_freiburg2_desk``. Returns the intrinsics and where they came from."""
     if isinstance(spec, Intrinsics):
         return spec, "given"
+    if spec is None and (root / CAM_JSON).is_file():
+        spec = root / CAM_JSON
     if spec is None:
         m = re.search(r"freiburg([123])", root.resolve().name)
         if m is None:
@@ -85,18 +88,13 @@ def load_intrinsics(spec: str | Path | Intrinsics | None, root: Path,
     p = Path(spec)
     if not p.is_file():
         raise InputError(f"--intrinsics must be fr1, fr2, fr3 or a JSON file; {p} not found")
-    try:
-        d = json.loads(p.read_text())
-        fx, fy, cx, cy = (float(d[k]) for k in ("fx", "fy", "cx", "cy"))
-        size = (int(d["width"]), int(d["height"])) if "width" in d and "height" in d else None
-    except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError, ValueError, AttributeError) as e:
-        raise InputError(f"intrinsics file {p}: need a JSON object with fx, fy, cx, cy ({e!r})") from None
-    if size is None:
-        if first_rgb is None:
-            raise InputError(f"intrinsics file {p}: needs width and height")
-        h, w = read_rgb(first_rgb).shape[:2]
-        size = (w, h)
-    return Intrinsics(fx, fy, cx, cy, *size), str(p)
+    size = None
+    if first_rgb is not None:
+        try:
+            size = image_size(first_rgb)
+        except InputError:  # its frame is skipped later; the file may still give the size
+            pass
+    return read_json(p, size), str(p)
 
 
 def read_rgb(path: Path) -> NDArray[np.uint8]:
@@ -129,6 +127,7 @@ class TumReader:
             raise InputError(f"--depth-scale must be a positive number, got {depth_scale}")
         if not max_dt > 0:
             raise InputError(f"--max-dt must be > 0 s, got {max_dt}")
+        check_gap(max_pose_gap)
         self.depth_scale = float(depth_scale)
         rgb = read_list(root / "rgb.txt", 2, "colour list")
         dep = read_list(root / "depth.txt", 2, "depth list")
@@ -142,6 +141,8 @@ class TumReader:
             raise InputError(f"{root}: {len(missing)} listed images are missing, e.g. "
                              + ", ".join(str(root / m) for m in missing[:3]))
         self.K, k_src = load_intrinsics(intrinsics, root, root / rgb[0][1])
+        check_fit(self.K, k_src, [root / r[1] for r in rgb[:5]], "the colour image")
+        check_fit(self.K, k_src, [root / r[1] for r in dep[:5]], "the depth image")
         g = np.array([[float(v) for v in r[:8]] for r in gt])
         track = PoseTrack(g[:, 0], poses_from_quat(g[:, 0], g[:, 1:4], g[:, 4:8],
                                                    [f"{gt_path} line {r[8]}" for r in gt]), str(gt_path))
@@ -160,7 +161,7 @@ class TumReader:
             elif not has_pose[i]:
                 self.skipped.add(name, t_rgb[i], "no pose", why[i])
             else:
-                self.frames.append(PlannedFrame(name, float(t_rgb[i]), poses[i], root / name, root / dep[j[i]][1]))
+                self.frames.append(PlannedFrame(name, float(t_rgb[i]), poses[i], root / name, root / dep[j[i]][1], i))
         self.meta: dict[str, Any] = {"intrinsics_source": k_src, "depth_scale_in": self.depth_scale,
                                      "max_dt": max_dt, "colour_images": len(rgb), "depth_images": len(dep),
                                      "poses": len(track)}

@@ -1,0 +1,132 @@
+"""Which recording layout a folder (or file) is, from the files it holds, and the reader for it.
+
+``capnav import auto SRC`` asks ``detect``; each layout names the files that gave it away, so the
+user reads what was recognised. A folder matching no layout gets the list of what was looked for.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from capnav.core.errors import CapNavError, InputError
+
+if TYPE_CHECKING:
+    from capnav.io.importer import Recording
+
+
+@dataclass(frozen=True)
+class Layout:
+    """A recording layout: its name, what it looks like, a test returning the evidence (or None), its reader."""
+
+    name: str
+    looks_like: str
+    evidence: Callable[[Path], str | None]
+    reader: Callable[..., Recording] | None  # keyword options: intrinsics, depth_scale
+
+
+def _has(root: Path, *names: str) -> bool:
+    return all((root / n).exists() for n in names)
+
+
+def _capnav(root: Path) -> str | None:
+    if not (root / "meta.json").is_file():
+        return None
+    try:
+        from capnav.core.jsonfile import read_json_object
+
+        if read_json_object(root / "meta.json", "meta.json").get("format") == "capnav-rgbd":
+            return "meta.json says capnav-rgbd"
+    except CapNavError:  # a broken meta.json is simply not this layout
+        return None
+    return None
+
+
+def _tum(root: Path) -> str | None:
+    return "rgb.txt, depth.txt" + (", groundtruth.txt" if _has(root, "groundtruth.txt") else "") \
+        if _has(root, "rgb.txt", "depth.txt") else None
+
+
+def _rosbag(root: Path) -> str | None:
+    if root.is_file() and root.suffix == ".bag":
+        return "a .bag file"
+    if root.is_dir() and (root / "metadata.yaml").is_file() and any(root.glob("*.db3")) | any(root.glob("*.mcap")):
+        return "metadata.yaml and a .db3/.mcap file (ROS2 bag)"
+    return None
+
+
+def _scannet(root: Path) -> str | None:
+    return "color/, depth/, pose/, intrinsic/" if _has(root, "color", "depth", "pose", "intrinsic") else None
+
+
+def _open3d(root: Path) -> str | None:
+    from capnav.io.open3d_log import find_colour_dir, find_log
+
+    c, log = find_colour_dir(root), find_log(root)
+    if c is None or log is None or not (root / "depth").is_dir():
+        return None
+    return f"{c.name}/, depth/, {log.name}"
+
+
+def _3dmatch(root: Path) -> str | None:
+    from capnav.io.threedmatch import sequence_dirs
+
+    seqs = sequence_dirs(root)
+    if not seqs:
+        return None
+    where = "" if seqs == [root] else f" in {len(seqs)} sequence folder(s) ({', '.join(s.name for s in seqs[:3])})"
+    return f"frame-XXXXXX.color/.depth/.pose files{where}"
+
+
+def _stray(root: Path) -> str | None:
+    if not _has(root, "odometry.csv", "camera_matrix.csv", "depth"):
+        return None
+    return "odometry.csv, camera_matrix.csv, depth/" + (", rgb.mp4" if _has(root, "rgb.mp4") else "")
+
+
+def _open(module: str, cls: str) -> Callable[..., Recording]:
+    def make(src: Path, **opts: Any) -> Recording:
+        import importlib
+
+        reader: Recording = getattr(importlib.import_module(module), cls)(src, **opts)
+        return reader
+    return make
+
+
+LAYOUTS: tuple[Layout, ...] = (
+    Layout("capnav-rgbd", "meta.json with format capnav-rgbd (already a CapNav dataset)", _capnav, None),
+    Layout("tum", "rgb.txt, depth.txt, groundtruth.txt", _tum, _open("capnav.io.tum", "TumReader")),
+    Layout("rosbag", "a ROS1 .bag file or a ROS2 bag folder", _rosbag, None),
+    Layout("scannet", "color/, depth/, pose/, intrinsic/ (ScanNet's exported frames)", _scannet,
+           _open("capnav.io.scannet", "ScannetReader")),
+    Layout("open3d", "image/ (or color/), depth/, trajectory.log (Open3D / Redwood)", _open3d,
+           _open("capnav.io.open3d_log", "Open3dReader")),
+    Layout("3dmatch", "frame-XXXXXX.color.png|jpg, .depth.png, .pose.txt, camera-intrinsics.txt", _3dmatch,
+           _open("capnav.io.threedmatch", "ThreeDMatchReader")),
+)
+
+
+def detect(src: Path) -> tuple[Layout, str]:
+    """The layout of ``src`` and the files that show it; an ``InputError`` listing the layouts otherwise."""
+    if not src.exists():
+        raise InputError(f"recording not found: {src}")
+    for lay in LAYOUTS:
+        ev = lay.evidence(src) if src.is_dir() or lay.name == "rosbag" else None
+        if ev is not None:
+            return lay, ev
+    known = "; ".join(f"{lay.name}: {lay.looks_like}" for lay in LAYOUTS)
+    raise InputError(f"{src}: not a recording layout CapNav knows. Looked for {known}")
+
+
+def open_recording(src: Path, **opts: Any) -> tuple[Recording, Layout, str]:
+    """Detect the layout of ``src`` and open it with its reader; ``opts`` (``intrinsics``, ``depth_scale``)
+    that are None keep the layout's own default."""
+    lay, ev = detect(src)
+    if lay.name == "capnav-rgbd":
+        raise InputError(f"{src} is already a capnav-rgbd dataset ({ev}); map it directly (capnav map {src} ...)")
+    if lay.reader is None:
+        raise InputError(f"{src} is a ROS bag ({ev}); its topics must be named: capnav import rosbag {src} -o OUT "
+                         "--rgb-topic T --depth-topic T --info-topic T --pose-topic T")
+    return lay.reader(src, **{k: v for k, v in opts.items() if v is not None}), lay, ev

@@ -1,0 +1,154 @@
+"""Frame-per-file layouts (Open3D, 3DMatch, ScanNet) and ``capnav import auto``: simulator frames
+written in each layout, in a recording world whose up is not +z, come back as the original z-up
+poses with the frames in source order; each layout's bad input is refused with its cause or counted."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+from typer.testing import CliRunner
+
+from capnav.cli import app
+from capnav.core.errors import InputError
+from capnav.core.frame import Frame
+from capnav.io.dataset import DatasetReader
+from capnav.io.export import tilt_matrix, writer
+from capnav.io.importer import import_recording
+from capnav.io.intrinsics import from_json
+from capnav.io.layouts import detect, open_recording
+from capnav.io.open3d_log import Open3dReader
+
+# the recording's world: the first camera looks along +z with y down, as Open3D and TUM logs often are
+W = tilt_matrix("90,0,0")
+W[:3, 3] = [0.0, 1.2, 0.0]  # the floor at y = +1.2 m (horizontal offsets are kept as recorded)
+
+
+@pytest.fixture(scope="module")
+def frames(render_views) -> list[Frame]:  # type: ignore[no-untyped-def]
+    return render_views(5, [18.0 + 4 * i for i in range(6)])
+
+
+def export(layout: str, frames: list[Frame], root: Path) -> Path:
+    moved = [Frame(index=f.index, rgb=f.rgb, depth=f.depth, K=f.K, T_wc=W @ f.T_wc, timestamp=f.timestamp)
+             for f in frames]
+    writer(layout)(moved, frames[0].K, root)
+    return root
+
+
+def _pose_err(A: np.ndarray, B: np.ndarray) -> tuple[float, float]:
+    c = (np.trace(A[:3, :3].T @ B[:3, :3]) - 1) / 2
+    return float(np.linalg.norm(A[:3, 3] - B[:3, 3])), float(np.degrees(np.arccos(np.clip(c, -1, 1))))
+
+
+@pytest.mark.parametrize("layout", ["open3d", "3dmatch", "scannet", "tum"])
+def test_auto_reads_every_exported_layout_back(tmp_path: Path, frames: list[Frame], layout: str) -> None:
+    src = export(layout, frames, tmp_path / "rec")
+    res = CliRunner().invoke(app, ["import", "auto", str(src), "-o", str(tmp_path / "ds"), "--no-progress"])
+    assert res.exit_code == 0, res.output + repr(res.exception)
+    assert f"{layout} layout" in res.output and "up found" in res.output
+    ds = DatasetReader(tmp_path / "ds")
+    assert len(ds) == len(frames)
+    assert np.allclose(list(ds.intrinsics.to_dict().values()), list(frames[0].K.to_dict().values()), atol=1e-6)
+    imp = ds.meta["meta"]["import"]
+    assert [r[1] for r in imp["frames"]] == list(range(len(frames)))  # source order, source index kept
+    for g, orig in zip(ds, frames, strict=True):
+        dt, dr = _pose_err(g.T_wc, orig.T_wc)
+        assert dt < 0.02 and dr < 1.0, (layout, g.index, dt, dr)  # the world's yaw is kept: compare directly
+        ok = orig.valid_depth() & (orig.depth < 10)
+        both = ok & (g.depth > 0)
+        assert both.sum() > 0.95 * ok.sum()
+        assert np.abs(g.depth[both] - orig.depth[both]).max() < 0.002
+        if layout != "scannet":  # ScanNet's colour comes at another resolution and as JPEG
+            assert np.array_equal(g.rgb, orig.rgb)
+        else:
+            assert np.abs(g.rgb.astype(int) - orig.rgb.astype(int)).mean() < 8
+
+
+def test_open3d_order_missing_poses_and_fit(tmp_path: Path, frames: list[Frame]) -> None:
+    src = export("open3d", frames, tmp_path / "rec")
+    log = (src / "trajectory.log").read_text().splitlines()
+    (src / "trajectory.log").write_text("\n".join(log[:20]) + "\n")  # 4 poses for 6 images
+    rec = Open3dReader(src)
+    assert [f.source_index for f in rec.frames] == [0, 1, 2, 3]
+    assert rec.skipped.counts() == {"no pose": 2}
+    assert "4 poses for 6 images" in rec.skipped.skips[0].detail and rec.skipped.skips[0].name == "00004.png"
+    rep = import_recording(rec, tmp_path / "ds", progress=False)
+    assert rep.written == 4 and "skipped 2: no pose" in "\n".join(rep.lines())
+    (src / "trajectory.log").unlink()
+    with pytest.raises(InputError, match=r"missing pose file: .*trajectory.log"):
+        Open3dReader(src)
+    (src / "trajectory.log").write_text("\n".join(log) + "\n")
+    K = frames[0].K
+    (src / "camera_intrinsic.json").write_text(json.dumps({"width": 640, "height": 480, "intrinsic_matrix": [
+        525.0, 0, 0, 0, 525.0, 0, 319.5, 239.5, 1]}))
+    with pytest.raises(InputError, match=r"are for 640x480 but the depth image .* is 160x120"):
+        Open3dReader(src)
+    (src / "camera_intrinsic.json").write_text(json.dumps({"width": K.width, "height": K.height,
+                                                           "intrinsic_matrix": [K.fx, 0, 0, 0, K.fy, 0, 300, 200, 1]}))
+    with pytest.raises(InputError, match=r"principal point at \(300, 200\), outside the 160x120 image"):
+        Open3dReader(src)
+
+
+def test_log_entries_name_their_frames(tmp_path: Path, frames: list[Frame]) -> None:
+    """A log that skipped a frame (its "i j k" lines say which) pairs each pose with its own image."""
+    src = export("open3d", frames, tmp_path / "rec")
+    blocks = (src / "trajectory.log").read_text().splitlines()
+    (src / "trajectory.log").write_text("\n".join(blocks[:10] + blocks[15:]) + "\n")  # no entry for frame 2
+    rec = Open3dReader(src)
+    assert [f.source_index for f in rec.frames] == [0, 1, 3, 4, 5]
+    assert np.allclose(rec.frames[2].T_wc, W @ frames[3].T_wc, atol=1e-6)
+
+
+def test_intrinsics_json_both_orders() -> None:
+    col = from_json({"width": 640, "height": 480, "intrinsic_matrix": [500, 0, 0, 0, 501, 0, 320, 240, 1]}, "x", None)
+    row = from_json({"width": 640, "height": 480, "intrinsic_matrix": [500, 0, 320, 0, 501, 240, 0, 0, 1]}, "x", None)
+    assert col == row and (col.fx, col.fy, col.cx, col.cy) == (500, 501, 320, 240)
+    with pytest.raises(InputError, match="not a pinhole matrix"):
+        from_json({"width": 1, "height": 1, "intrinsic_matrix": [1, 2, 3, 4, 5, 6, 7, 8, 9]}, "x", None)
+
+
+def test_3dmatch_and_scannet_bad_input(tmp_path: Path, frames: list[Frame]) -> None:
+    src = export("3dmatch", frames[:3], tmp_path / "m")
+    (src / "seq-01" / "frame-000001.pose.txt").unlink()
+    rec, lay, ev = open_recording(src)
+    assert lay.name == "3dmatch" and "1 sequence folder" in ev
+    assert rec.skipped.counts() == {"no pose": 1} and "missing pose file" in rec.skipped.skips[0].detail
+    (src / "camera-intrinsics.txt").unlink()
+    with pytest.raises(InputError, match=r"missing intrinsics file camera-intrinsics\.txt"):
+        open_recording(src)
+    src = export("scannet", frames[:3], tmp_path / "s")
+    (src / "pose" / "1.txt").write_text("\n".join(["-inf -inf -inf -inf"] * 4) + "\n")  # tracking lost
+    rec, lay, _ = open_recording(src)
+    assert lay.name == "scannet" and rec.skipped.counts() == {"no pose": 1}
+    assert "non-finite" in rec.skipped.skips[0].detail
+    shutil.rmtree(src / "pose")
+    (src / "pose").mkdir()
+    with pytest.raises(InputError, match=r"no frame has both a depth image and a pose .*missing pose file"):
+        open_recording(src)
+
+
+def test_auto_names_what_it_looked_for(tmp_path: Path) -> None:
+    (tmp_path / "x").mkdir()
+    Image.fromarray(np.zeros((4, 4, 3), np.uint8)).save(tmp_path / "x" / "a.png")
+    with pytest.raises(InputError, match=r"not a recording layout CapNav knows. Looked for .*open3d: image/"):
+        detect(tmp_path / "x")
+
+
+ICL = Path(__file__).resolve().parents[2].parent / "shared" / "realdata" / "icl-livingroom1"
+
+
+@pytest.mark.skipif(not ICL.is_dir(), reason="needs ../shared/realdata/icl-livingroom1")
+def test_icl_livingroom_imports_with_no_option(tmp_path: Path) -> None:
+    """The real Open3D folder: up (the first camera's -y) found with no option, cameras about 1 m up."""
+    res = CliRunner().invoke(app, ["import", "auto", str(ICL), "-o", str(tmp_path / "icl"), "--stride", "15",
+                                   "--no-progress"])
+    assert res.exit_code == 0, res.output + repr(res.exception)
+    assert "open3d layout (image/, depth/, trajectory.log)" in res.output
+    al = DatasetReader(tmp_path / "icl").meta["meta"]["alignment"]
+    assert al["nearest_axis"] == "-y" and al["axis_angle_deg"] < 5
+    assert 0.7 < al["facts"]["camera_height_median_m"] < 1.3
