@@ -207,6 +207,9 @@ class Mapper:
             "text_space": self.encoder.text_space,
             "config": self.config.to_dict(),
         }  # no wall-clock time here: the same input gives the same map file, byte for byte (self.seconds)
+        labels = getattr(self.detector, "labels", None)
+        if labels is not None:  # a closed vocabulary: what the map can never contain is known
+            info["detector_labels"] = sorted(labels)
         info.update(meta or {})
         path = (CameraTrajectory(np.array([i for i, _ in self.camera_path]), np.stack([T for _, T in self.camera_path]))
                 if self.camera_path else None)

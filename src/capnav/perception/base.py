@@ -85,6 +85,10 @@ class Detector(ABC):
     #: True for detectors that read the simulator's truth images (``Frame.gt_instance``), which a
     #: real recording does not have: mapping such a dataset with one is refused before any frame.
     needs_truth: bool = False
+    #: The labels it can output (a closed vocabulary, recorded in the map so that a request for
+    #: anything else is answered "the detector cannot see one", not "there is none"); None when
+    #: any category may come out (the simulator's truth, an open vocabulary not recorded).
+    labels: frozenset[str] | None = None
 
     @abstractmethod
     def detect(self, frame: Frame) -> list[Detection]:

@@ -96,6 +96,7 @@ class CocoDetector(Detector):
             raise InputError(f"unknown mask mode {mask!r}; available: {', '.join(COCO_MASK_MODES)}")
         self.max_detections, self.threads, self.letterbox, self.mask_mode = max_detections, threads, letterbox, mask
         self.table = class_table(classes)
+        self.labels = frozenset(t[1] for t in self.table if t is not None)
         self.classes_id = classes if isinstance(classes, str) and classes in ("indoor", "all") else \
             f"{sum(t is not None for t in self.table)}"
         if model_dir is not None and not isinstance(model_dir, (str, Path)):

@@ -179,6 +179,7 @@ class OwlDetector(Detector):
         self.model_path, self.sam_path = folder, sam_folder
         self.words = parse_vocabulary(vocabulary)
         self.classes = vocabulary_labels(self.words)
+        self.labels = frozenset(label for _, label in self.classes)
         try:
             self.prompts = [prompt.format(w) for w in self.words]
         except (IndexError, KeyError, ValueError) as e:

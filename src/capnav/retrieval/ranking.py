@@ -1,6 +1,9 @@
-"""Cosine ranking (eq. 16), top-K and maximal marginal relevance over caption embeddings."""
+"""Cosine ranking (eq. 16), top-K and maximal marginal relevance over caption embeddings, and the
+order the constraints' keys give (``Ranking``)."""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -46,3 +49,44 @@ def mmr(E: F32, scores: NDArray[np.floating], candidates: NDArray[np.intp], lam:
         left[j] = False
         max_sim = np.maximum(max_sim, sim[j])
     return np.asarray([cand[j] for j in chosen], dtype=np.intp)
+
+
+@dataclass
+class Ranking:
+    """The retrieval order with what decided it."""
+
+    order: NDArray[np.intp]  # candidate indices, best first
+    groups: NDArray[np.int64]  # per position: predicate group (ties on the predicate share one)
+    mode: str  # "semantic", "predicate" or "closest"
+    predicate: str | None
+    weights: NDArray[np.float64]  # per object: category weight (1 named, < 1 alternative)
+    terms: dict[int, dict[str, float]]  # per candidate: the predicate's values (distance, volume, ...)
+    refusal: str | None = None  # a reason to answer "not found" before verification
+    refused_by: str | None = None  # the kind of constraint that refused
+
+
+def semantic_order(E: F32, s: NDArray[np.float32], pool: NDArray[np.intp], weights: NDArray[np.float64],
+                   k: int, lam: float | None) -> tuple[NDArray[np.intp], NDArray[np.int64]]:
+    """Per category tier (named category, then alternatives), the ``k`` most similar with MMR
+    (``lam`` None: without); the group of each is its tier."""
+    tiers = sorted(set(weights[pool].tolist()), reverse=True)
+    parts = []
+    for w in tiers:
+        tier = pool[weights[pool] == w]
+        sub = top_k(s, k, tier[np.lexsort((tier, -s[tier]))])
+        parts.append(mmr(E, s, sub, lam) if lam is not None else sub)
+    order = np.concatenate(parts) if parts else pool
+    tier_of = {int(i): t for t, w in enumerate(tiers) for i in pool[weights[pool] == w]}
+    return order, np.array([tier_of[int(i)] for i in order], dtype=np.int64)
+
+
+def keyed_order(s: NDArray[np.float32], pool: NDArray[np.intp], group_keys: list[NDArray[np.float64]],
+                order_keys: list[NDArray[np.float64]]) -> tuple[NDArray[np.intp], NDArray[np.int64]]:
+    """Lexicographic: first group key most significant; then order keys, similarity, index. A
+    group is a run of candidates equal on every group key."""
+    keys = [pool.astype(np.float64), -s[pool].astype(np.float64), *reversed(order_keys), *reversed(group_keys)]
+    perm = np.lexsort(keys)
+    order = pool[perm]
+    gk = np.stack([k[perm] for k in group_keys], axis=1)
+    change = np.r_[True, np.any(gk[1:] != gk[:-1], axis=1)] if len(gk) else np.zeros(0, bool)
+    return order, np.asarray(np.cumsum(change) - 1, dtype=np.int64)

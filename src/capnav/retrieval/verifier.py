@@ -20,7 +20,7 @@ import re
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -34,9 +34,11 @@ from capnav.language.embedder import TextEmbedder
 from capnav.language.form import shape_conflict
 from capnav.language.offline_captioner import ObservationCaptioner
 from capnav.language.prompts import Verdict, caption_name, parse_verdict, verification_prompt
-from capnav.language.surface import Surface, grain_agrees, material_conflict, material_shows
+from capnav.language.surface import Surface, grain_agrees, material_conflict
 from capnav.language.vlm.base import RateLimited, VisionLanguageModel, create_vlm
 from capnav.mapping.objects import MapObject
+from capnav.retrieval.constraints import Evidence, attribute_constraints
+from capnav.retrieval.constraints.name import Name
 from capnav.retrieval.query import ParsedQuery
 
 log = logging.getLogger(__name__)
@@ -67,6 +69,7 @@ class Assessment:
     value: float
     terms: dict[str, float]
     reason: str
+    evidence: list[Evidence] = field(default_factory=list)  # per constraint, in the order judged
 
 
 def target_description(q: ParsedQuery) -> str:
@@ -316,40 +319,30 @@ class OfflineVerifier(Verifier):
         return frac if q.size_word == "large" else 1.0 - frac
 
     def assess(self, query: ParsedQuery, c: Candidate, position: float = 0.0) -> Assessment:
-        """Judge one candidate; ``position`` in [0, 1) is its place in the batch (0 = first)."""
+        """Judge one candidate; ``position`` in [0, 1) is its place in the batch (0 = first).
+
+        The name first (its weight tells the others whether a stand-in is judged), then every
+        attribute constraint the query states: the first contradicted one refuses the candidate
+        with its clause; otherwise the value adds each one's agreement with its weight."""
         cfg = self.config
-        ok, weight, why = self.name_agreement(query, c.obj)
         terms: dict[str, float] = {"similarity": round(c.score, 3), "rank": round(1.0 - position, 3)}
-        if not ok:
-            return Assessment(False, 0.0, terms, why)
-        if weight < 1.0:
-            terms["category"] = round(weight, 3)
-        col, fit, cwhy = self.color_fit(query, c.obj)
-        if query.colors:
-            terms["colour"] = round(col, 3)
-            if fit < cfg.color_reject:
-                return Assessment(False, 0.0, terms, f"{why} but {cwhy}, below {cfg.color_reject:.2f}")
-        size = self.size(query, c.obj)
-        if query.size_word:
-            terms["size"] = round(size, 3)
-        shape, swhy = self.shape(query, c.obj)
-        if shape is None:
-            return Assessment(False, 0.0, terms, f"{why} but {swhy}")
-        if query.shapes:
-            terms["shape"] = round(shape, 3)
-        mat, mwhy = self.material(query, c.obj)
-        if mat is None:
-            return Assessment(False, 0.0, terms, f"{why} but {mwhy}")
-        if weight < 1.0 and mat < 1.0 and any(map(material_shows, query.materials)):
-            # Another category stands in for the named one only when its pixels show the spoken
-            # material: "the leather sofa" is not a chair of unknown surface.
-            return Assessment(False, 0.0, terms, f"{why} but its pixels do not show {'/'.join(query.materials)} "
-                                                 f"({mwhy})")
-        if query.materials:
-            terms["material"] = round(mat, 3)
-        val = (cfg.w_rank * (1.0 - position) + cfg.w_color * col + cfg.w_size * size + cfg.w_shape * shape
-               + cfg.w_material * mat - cfg.w_alternative * (1.0 - weight))
-        return Assessment(True, float(val), terms, "; ".join(x for x in (why, cwhy, swhy, mwhy) if x))
+        name = Name().judge(self, query, c.obj)
+        evidence = [name]
+        terms.update(name.terms)
+        if name.refuses:
+            return Assessment(False, 0.0, terms, name.clause, evidence)
+        weight = name.value
+        val = cfg.w_rank * (1.0 - position)
+        for con in attribute_constraints(query):
+            ev = con.judge(self, query, c.obj, weight)
+            evidence.append(ev)
+            terms.update(ev.terms)
+            if ev.refuses:
+                return Assessment(False, 0.0, terms, f"{name.clause} but {ev.clause}", evidence)
+            val += float(getattr(cfg, con.weight_field)) * ev.value
+        val -= cfg.w_alternative * (1.0 - weight)
+        reason = "; ".join(e.clause for e in evidence if e.clause)
+        return Assessment(True, float(val), terms, reason, evidence)
 
     def verify(self, query: ParsedQuery, batch: list[Candidate]) -> Verdict:
         best: tuple[int, float, int, str] | None = None

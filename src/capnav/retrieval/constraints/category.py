@@ -1,0 +1,64 @@
+"""The named category (the paper's type filter): its instances first, then the alternatives the
+parser offered (an armchair for "chair", weighted below 1); with none in the map, every object."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from capnav.language.context import canonical_label
+from capnav.retrieval.constraints.base import RankingConstraint, RankState, ranking
+from capnav.retrieval.query import ParsedQuery
+
+
+@ranking
+class Category(RankingConstraint):
+    kind = "category"
+    order = 10
+
+    @staticmethod
+    def applies(q: ParsedQuery) -> bool:
+        return True  # it also sets up the pool: every object when nothing is named
+
+    def rank(self, st: RankState) -> None:
+        r, q, cfg = st.r, st.q, st.r.config
+        n = len(r.objects)
+        weights = self.weights(st) if cfg.use_type_filter else np.zeros(n)
+        st.named = q.category is not None or bool(q.category_alternatives)
+        pool = np.flatnonzero(weights > 0)
+        if st.named and cfg.use_type_filter and len(pool):
+            tier1 = int((weights[pool] >= 1.0).sum())
+            what = q.category or q.purpose or "target"
+            st.notes.append(f"{tier1} {what}(s) in the map" + (
+                f", {len(pool) - tier1} alternative(s) ({', '.join(sorted(q.category_alternatives))})"
+                if len(pool) > tier1 else ""))
+        else:
+            if st.named and cfg.use_type_filter:
+                st.notes.append(f"no object in the map is captioned or labelled {q.category or 'as one of '}"
+                                + ("" if q.category else ", ".join(sorted(q.category_alternatives))))
+            pool = np.arange(n)
+            weights = np.ones(n)
+        st.pool, st.weights = pool, weights
+        if st.named and q.purpose is None and cfg.use_type_filter and len(pool) and not (weights[pool] >= 1.0).any():
+            # No instance of the named category: an alternative serves only a request whose observed
+            # attributes or landmark it shows ("the round wooden table" -> a round coffee table),
+            # never a bare name ("the desk" is not the kitchen table). A purpose names several.
+            if q.shapes:
+                st.keep(np.array([all(w.lower() in (r.objects[i].caption or "").lower() for w in q.shapes)
+                                  for i in st.pool], dtype=bool))
+            if not (q.colors or q.shapes or q.anchor_category) or not len(st.pool):
+                st.refuse(self.kind, f"no {q.category or q.target_phrase} in the map, and nothing else fits "
+                                     f"'{q.target_phrase}' by what was observed")
+        st.group_keys.append(-st.weights[st.pool])
+
+    @staticmethod
+    def weights(st: RankState) -> NDArray[np.float64]:
+        """Per object: 1 for the named category, the parser's weight for an alternative, else 0."""
+        r, q = st.r, st.q
+        w = np.zeros(len(r.objects))
+        for cat, weight in q.category_alternatives.items():
+            idx = r.of_category(canonical_label(cat))
+            w[idx] = np.maximum(w[idx], float(weight))
+        if q.category is not None:
+            w[r.of_category(q.category)] = 1.0
+        return w

@@ -1,0 +1,83 @@
+"""A negation ("not the white one", "the bookshelf that isn't grey"): the candidates it names
+leave the pool; when it leaves no other one of the named category, "not found"."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from capnav.core.errors import InputError
+from capnav.retrieval.constraints.base import CONTRADICTED, Evidence, RankingConstraint, RankState, ranking
+from capnav.retrieval.query import ParsedQuery, parse_instruction
+
+
+@ranking
+class Negation(RankingConstraint):
+    kind = "negation"
+    order = 20
+
+    @staticmethod
+    def applies(q: ParsedQuery) -> bool:
+        return bool(q.negations)
+
+    def rank(self, st: RankState) -> None:
+        if not len(st.pool):
+            return
+        q, r = st.q, st.r
+        neg = self.excluded(st)
+        if not neg:
+            return
+        st.notes.append("excluded by the negation: " + ", ".join(
+            f"object {r.objects[i].id} ({neg[i]})" for i in neg))
+        for i, phrase in neg.items():
+            st.report(self.kind, i, Evidence(self.kind, CONTRADICTED, 0.0, f"it is what '{phrase}' excludes"))
+        had_named = bool((st.weights[st.pool] >= 1.0).any())
+        st.keep(np.array([int(i) not in neg for i in st.pool], dtype=bool))
+        if not len(st.pool) or (had_named and not (st.weights[st.pool] >= 1.0).any()):
+            # "not the white washer, the other one" presumes another of that category: an
+            # alternative category ("a fridge can serve as a washer") is no "other one".
+            st.refuse(self.kind, f"every {q.category or 'candidate'} matches what the instruction excludes "
+                                 f"({'; '.join(q.negations)})")
+
+    @staticmethod
+    def excluded(st: RankState) -> dict[int, str]:
+        """Candidates of the pool a negation names, with the phrase.
+
+        A negated colour is read as a definite description among the candidates: it names the
+        ones that fit it best (agreement at least ``color_reject``, and at least
+        ``negation_contrast`` of the best fit among the named category's candidates), not every
+        candidate that is somewhat that colour; so "not the yellow lamp, the other one" excludes
+        the mustard lamp although its agreement is below ``color_match``, and "not the white
+        washing machine" keeps the light grey one when a white one stands beside it."""
+        r, q, pool, weights = st.r, st.q, st.pool, st.weights
+        out: dict[int, str] = {}
+        named = pool[weights[pool] >= 1.0]
+        ref = named if len(named) else pool
+        for phrase in q.negations:
+            try:
+                nq = parse_instruction(phrase)
+            except InputError:
+                continue
+            if nq.category is not None and nq.category != q.category and not nq.colors and not nq.room:
+                continue  # "not the one at the end of the table": a relation this reader does not judge
+            fits = np.ones(len(pool), dtype=bool)
+            judged = False
+            if nq.category is not None and nq.category == q.category:
+                fits &= r.cats_arr[pool] == nq.category
+                judged = True
+            if nq.colors:
+                col = {int(i): r.judge.color(nq, r.objects[int(i)])[0] for i in pool}
+                best = max((col[int(i)] for i in ref), default=0.0)
+                bar = max(r.judge.config.color_reject, r.config.negation_contrast * best)
+                fits &= np.array([col[int(i)] >= bar for i in pool])
+                judged = True
+            if nq.room is not None:
+                fits &= np.array([r.scene.rooms[int(i)] == nq.room for i in pool])
+                judged = True
+            if nq.shapes:
+                fits &= np.array([all(w.lower() in (r.objects[int(i)].caption or "").lower() for w in nq.shapes)
+                                  for i in pool])
+                judged = True
+            if judged:
+                for i in pool[fits]:
+                    out.setdefault(int(i), phrase)
+        return out

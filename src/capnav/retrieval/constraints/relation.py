@@ -1,0 +1,108 @@
+"""A landmark relation: "next to the cactus", "between the sofa and the armchair", "at the end of
+the table", "in the room with the pink dresser", "the chair closest to the table". The landmark is
+resolved first (its colour, room or growth form picks the instance), then the candidates are
+ordered by the relation's geometry in quarter-metre bins, so attributes break only near-ties."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from capnav.core.errors import InputError
+from capnav.retrieval.constraints.base import RankingConstraint, RankState, ranking
+from capnav.retrieval.query import BETWEEN, END_OF, ROOM_WITH, ParsedQuery, parse_instruction
+from capnav.retrieval.spatial import end_distance, has_long_axis, segment_distance
+
+BIN_M = 0.25  # distances closer than this are a tie on the relation
+
+
+def landmarks(st: RankState, second: bool = False) -> NDArray[np.intp]:
+    """The landmark's instances (the second landmark's of "between" with ``second``): of its
+    category, and when its phrase says a colour, a room or a shape, only the instance(s) that fit
+    best ("the yellow lamp", "the cactus")."""
+    r, q, notes = st.r, st.q, st.notes
+    category, phrase = (q.anchor2_category, q.anchor2_phrase) if second else (q.anchor_category, q.anchor_phrase)
+    assert category is not None
+    anchors = r.of_category(category)
+    if len(anchors) < 2 or not phrase:
+        return anchors
+    try:
+        aq = parse_instruction(phrase)
+    except InputError:
+        return anchors
+    if aq.colors:
+        agree = np.array([r.judge.color(aq, r.objects[k])[0] for k in anchors])
+        keep = anchors[agree >= max(r.judge.config.color_reject, agree.max() - 0.05)]
+        notes.append(f"landmark '{phrase}': object {', '.join(str(r.objects[k].id) for k in keep)}")
+        anchors = keep
+    if aq.room is not None:
+        inroom = anchors[[r.scene.rooms[k] == aq.room for k in anchors]]
+        anchors = inroom if len(inroom) else anchors
+    if aq.shapes and len(anchors) > 1:
+        # "next to the cactus": the plants whose points show the cactus's growth form.
+        agree = np.array([r.judge.shape(aq, r.objects[k])[0] or 0.0 for k in anchors])
+        if agree.max() > 0:
+            anchors = anchors[agree >= agree.max()]
+            notes.append(f"landmark '{phrase}': object {', '.join(str(r.objects[k].id) for k in anchors)}")
+    return anchors
+
+
+@ranking
+class Relation(RankingConstraint):
+    kind = "relation"
+    order = 40
+
+    @staticmethod
+    def applies(q: ParsedQuery) -> bool:
+        return (q.relation is not None or q.proximity_to_anchor) and q.anchor_category is not None
+
+    def rank(self, st: RankState) -> None:
+        r, q, pool = st.r, st.q, st.pool
+        if not r.config.use_predicates:
+            return
+        anchors = landmarks(st)
+        if not len(anchors):
+            st.notes.append(f"no {q.anchor_category} in the map to be {q.relation}")
+            return
+        xy = r.scene.xy
+        gap = r.scene.gap[np.ix_(pool, anchors)]
+        same = pool[:, None] == anchors[None, :]
+        gap = np.where(same, np.inf, gap).min(axis=1)
+        st.values["gap to landmark (m)"] = gap
+        regions = {int(r.scene.region[k]) for k in anchors} - {-1}
+        if q.relation == ROOM_WITH and regions:
+            # "the bed in the room with the pink dresser": the landmark's room region.
+            same_room = np.array([int(r.scene.region[i]) in regions for i in pool], dtype=np.float64)
+            st.group_keys.append(-same_room)
+            st.predicate = f"{ROOM_WITH} the {q.anchor_category}"
+            if not same_room.any():
+                st.refuse(self.kind, f"no {q.category or q.target_phrase} stands in the room with the "
+                                     f"{q.anchor_phrase}", override=False)
+        elif q.relation == BETWEEN and q.anchor2_category is not None and len(second := landmarks(st, True)):
+            # "the table between the sofa and the armchair": distance to the segment joining
+            # the two landmarks' centres (the best pair when there are several).
+            line = np.array([min((segment_distance(xy[i], xy[a_], xy[b_]) for a_ in anchors for b_ in second
+                                  if len({int(i), int(a_), int(b_)}) == 3), default=np.inf) for i in pool])
+            st.values["distance to the line between the landmarks (m)"] = line
+            st.group_keys.append(np.round(line / BIN_M))
+            st.predicate = f"between the {q.anchor_category} and the {q.anchor2_category}"
+        elif q.relation == END_OF and len(long_ := np.array(
+                [k for k in anchors if has_long_axis(r.objects[k].footprint)], dtype=np.intp)):
+            # "the chair at the end of the table": distance to the nearer end of the
+            # landmark's long axis (a round or square landmark has no end: "next to").
+            ends = np.array([min((end_distance(xy[i], r.objects[k].footprint) for k in long_ if k != i),
+                                 default=np.inf) for i in pool])
+            st.values["distance to the landmark's end (m)"] = ends
+            st.group_keys.append(np.round(ends / BIN_M))
+            st.predicate = f"{END_OF} the {q.anchor_category}"
+        elif q.proximity_to_anchor and q.proximity is not None:
+            # "the chair closest to the table": distance to the landmark, exactly.
+            centre = np.linalg.norm(xy[pool][:, None] - xy[anchors][None], axis=2)
+            centre = np.where(same, np.inf, centre).min(axis=1)
+            far = q.proximity == "farthest"
+            st.group_keys.append(-centre if far else centre)
+            st.predicate = f"{q.proximity} to the {q.anchor_category}"
+        else:
+            st.group_keys.append(np.round(gap / BIN_M))  # quarter-metre bins, attributes break ties
+            st.predicate = q.relation
+        st.mode = "predicate"

@@ -1,0 +1,85 @@
+"""The room ("the lamp in the study"): inferred from the objects around each candidate, never
+observed, so it orders (the named room, then no inferred room, then the strength of its cues) and
+refuses only where the evidence against it is confident."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from capnav.language.context import HALLWAY, ROOM_CUES
+from capnav.retrieval.constraints.base import (
+    CONTRADICTED,
+    SUPPORTED,
+    UNOBSERVED,
+    Evidence,
+    RankingConstraint,
+    RankState,
+    ranking,
+)
+from capnav.retrieval.query import ParsedQuery
+
+_ROOMS = list(ROOM_CUES)
+
+
+@ranking
+class Room(RankingConstraint):
+    kind = "room"
+    order = 30
+
+    @staticmethod
+    def applies(q: ParsedQuery) -> bool:
+        return q.room is not None
+
+    def rank(self, st: RankState) -> None:
+        q, r = st.q, st.r
+        assert q.room is not None
+        judged = r.config.use_predicates and len(st.pool) > 0
+        if judged and q.room in _ROOMS:
+            self._typed(st, q.room)
+        elif judged and q.room == HALLWAY:
+            self._hallway(st)
+        elif q.room not in _ROOMS:
+            st.notes.append(f"rooms of type '{q.room}' are not inferred from the map; the room was not used")
+
+    def _typed(self, st: RankState, room: str) -> None:
+        q, r, pool = st.q, st.r, st.pool
+        rooms = [r.scene.rooms[i] for i in pool]
+        in_room = np.array([x == room for x in rooms], dtype=np.float64)
+        unknown = np.array([x is None for x in rooms], dtype=np.float64)
+        strength = r.scene.room_score[pool, _ROOMS.index(room)]
+        for k, i in enumerate(pool):
+            status = SUPPORTED if in_room[k] else UNOBSERVED if unknown[k] else CONTRADICTED
+            seen = f"inferred room {rooms[k] or 'none'}"
+            st.report(self.kind, int(i), Evidence(self.kind, status, float(strength[k]), seen))
+        # Inferred room first, then objects of no inferred room, then the strength of the cues.
+        st.group_keys.insert(0, -(2 * in_room + unknown))  # the room before the category tier
+        st.order_keys.append(-strength)
+        st.values["room cue"] = strength
+        st.predicate, st.mode = "room", "predicate"
+        st.notes.append(f"{int(in_room.sum())} of them appear to be in the {room} (inferred from nearby objects)")
+        # A room is inferred, never observed: refuse only where the evidence against the named
+        # room is confident, i.e. no candidate of the best category tier has a cue of it in its
+        # own room (a wardrobe beside the desk of a room typed "office" by that desk says
+        # "bedroom" too). Weak evidence serves the named object, not a substitute for it.
+        top = st.weights[pool] >= st.weights[pool].max()
+        possible = (strength >= r.scene.config.room_min_score) & top
+        if not in_room.any() and not unknown.any() and not possible.any():
+            where = sorted({str(x) for x in rooms})
+            st.refuse(self.kind, f"no {q.category or q.target_phrase} stands in the {room}; "
+                                 f"{'they are' if len(pool) > 1 else 'it is'} in the {', the '.join(where)}")
+        elif not in_room.any() and possible.any():
+            k = int(np.argmax(strength))
+            st.notes.append(f"none is inferred to be in the {room}, but object {r.objects[pool[k]].id} "
+                            f"({r.scene.rooms[pool[k]]}) has {room} cues where it stands ({strength[k]:.2f})")
+
+    def _hallway(self, st: RankState) -> None:
+        # A hallway has no characteristic objects: objects of a region without any room's cues
+        # first, then the weakest cues of any room. No refusal: an untyped region is weak evidence.
+        r, pool = st.r, st.pool
+        untyped = np.array([r.scene.rooms[i] is None for i in pool], dtype=np.float64)
+        weakest = -r.scene.room_score[pool].max(axis=1)
+        st.group_keys.insert(0, -untyped)
+        st.order_keys.append(-weakest)
+        st.values["no room cue"] = weakest
+        st.predicate, st.mode = "room", "predicate"
+        st.notes.append(f"{int(untyped.sum())} of them stand where no room's objects are (a hallway)")

@@ -1,0 +1,24 @@
+"""A superlative of size ("the biggest armchair"): the mapped volume orders the candidates."""
+
+from __future__ import annotations
+
+from capnav.retrieval.constraints.base import RankingConstraint, RankState, ranking
+from capnav.retrieval.query import ParsedQuery
+
+
+@ranking
+class Superlative(RankingConstraint):
+    kind = "superlative"
+    order = 50
+
+    @staticmethod
+    def applies(q: ParsedQuery) -> bool:
+        return q.superlative is not None
+
+    def rank(self, st: RankState) -> None:
+        if not st.r.config.use_predicates:
+            return
+        vol = st.r.volume[st.pool]
+        st.group_keys.append(-vol if st.q.superlative == "largest" else vol)
+        st.values["volume (m3)"] = vol
+        st.predicate, st.mode = st.q.superlative, "predicate"
