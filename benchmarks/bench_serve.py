@@ -43,7 +43,7 @@ def wait_ready(url: str, proc: subprocess.Popen[bytes], timeout: float = 120.0) 
         if proc.poll() is not None:
             raise SystemExit(f"capnav serve exited with {proc.returncode}")
         try:
-            if httpx.get(url + "/healthz", timeout=2).status_code == 200:
+            if httpx.get(url + "/readyz", timeout=2).status_code == 200:
                 return
         except httpx.HTTPError:
             pass

@@ -26,10 +26,12 @@ def free_port() -> int:
 
 
 @contextlib.contextmanager
-def running_server(map_path: Path, timeout: float = 90.0) -> Iterator[str]:
-    """``capnav serve MAP`` as a child process; yields its base URL once /healthz answers."""
+def running_server(map_path: Path | list[Path], timeout: float = 90.0) -> Iterator[str]:
+    """``capnav serve MAP`` as a child process; yields its base URL once /readyz answers (maps and
+    embedder loaded)."""
     port = free_port()
-    cmd = [sys.executable, "-m", "capnav.cli", "serve", str(map_path), "--port", str(port)]
+    paths = map_path if isinstance(map_path, list) else [map_path]
+    cmd = [sys.executable, "-m", "capnav.cli", "serve", *map(str, paths), "--port", str(port)]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=os.environ.copy())
     url = f"http://127.0.0.1:{port}"
     try:
@@ -39,7 +41,7 @@ def running_server(map_path: Path, timeout: float = 90.0) -> Iterator[str]:
                 out = proc.stdout.read().decode() if proc.stdout else ""
                 raise RuntimeError(f"capnav serve exited with {proc.returncode}: {out}")
             try:
-                with urllib.request.urlopen(url + "/healthz", timeout=2) as r:
+                with urllib.request.urlopen(url + "/readyz", timeout=2) as r:
                     if r.status == 200:
                         break
             except OSError:

@@ -52,14 +52,17 @@ def test_query_answers_with_plan(client: TestClient) -> None:
     r = client.post("/api/query", json={"text": "the red sofa", "k": 2, "robot": [6.0, 3.0]})
     assert r.status_code == 200, r.text
     d = r.json()
-    assert d["found"] and d["object"]["id"] == 1 and "Chose object 1" in d["reason"]
+    assert d["found"] and d["chosen"]["id"] == 1 and "Chose object 1" in d["reason"]
+    assert d["object"] == d["chosen"] and d["robot_note"] == ""  # "object": the old name, kept one release
+    assert all(r["why"] and "similarity" in r["terms"] for r in d["runners_up"])  # why each one lost
     assert len(d["runners_up"]) <= 2 and all(o["id"] != 1 for o in d["runners_up"])
     assert d["goal"]["reached_within_reach"] and d["plan"]["success"] and d["plan"]["target"] == 1
     assert d["plan"]["poses"][0][:2] == [6.0, 3.0] and d["plan"]["length_m"] > 2.0
     d = client.post("/api/query", json={"text": "the red sofa"}).json()
     assert d["found"] and d["plan"] is None and "no robot position" in d["goal_note"]
     d = client.post("/api/query", json={"text": "the red sofa", "robot": [3.8, 6.0]}).json()
-    assert d["found"] and d["plan"] is None and "obstacle" in d["goal_note"]  # in the wall: no plan, still an answer
+    assert d["found"] and "inside an obstacle; moved" in d["robot_note"]  # in the wall: the nearest free cell
+    assert d["plan"]["success"] and d["plan"]["poses"][0][:2] != [3.8, 6.0]
     d = client.post("/api/query", json={"text": "the piano", "robot": [6.0, 3.0]}).json()
     assert not d["found"] and d["plan"] is None and d["reason"].startswith("Not found")
     p = client.post("/api/plan", json={"start": [6.0, 3.0, 0.0], "object": 7}).json()
@@ -74,15 +77,13 @@ def test_query_answers_with_plan(client: TestClient) -> None:
     ({"text": "the sofa", "k": 99}, 422, "'k'"),
     ({"text": "the sofa", "k": True}, 422, "'k'"),
     ({"text": "the sofa", "robot": [1, "a"]}, 422, "robot must be"),
-    ({"text": "the sofa", "robot": [100.0, 100.0]}, 200, ""),  # off the map: answered, no goal
+    ({"text": "the sofa", "robot": [100.0, 100.0]}, 422, "is off the map"),  # as a start off the map for /api/plan
+    ({"text": "the sofa", "robot": [1.0, 2.0, 3.0, 4.0]}, 422, "robot must be"),
 ])
 def test_bad_query_input_is_a_4xx_with_the_reason(client: TestClient, body: dict, status: int, why: str) -> None:
     r = client.post("/api/query", json=body)
     assert r.status_code == status, r.text
-    if status != 200:
-        assert why in r.json()["error"]
-    else:
-        assert r.json()["plan"] is None and r.json()["goal_note"]
+    assert why in r.json()["error"]
 
 
 def test_bad_bodies(client: TestClient) -> None:
@@ -141,7 +142,7 @@ def test_starts_like_navigate_on_a_map_with_a_camera_path(served_map: Path) -> N
         p = c.post("/api/plan", json={"object": 1}).json()
         assert p["success"] and p["poses"][0][:2] == [6.0, 3.0] and p["target"] == 1
         d = c.post("/api/query", json={"text": "the red sofa", "robot": [6.0, 3.0]}).json()
-        assert d["object"]["id"] == 1 and d["plan"]["success"] and d["plan"]["poses"][-1] == p["poses"][-1]
+        assert d["chosen"]["id"] == 1 and d["plan"]["success"] and d["plan"]["poses"][-1] == p["poses"][-1]
     with TestClient(create_app(served_map, ServeConfig(warm_up=False))) as c:  # no camera path: a start is needed
         r = c.post("/api/plan", json={"object": 1})
         assert r.status_code == 422 and "records no camera path" in r.json()["error"]

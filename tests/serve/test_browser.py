@@ -36,6 +36,8 @@ def test_browser_asks_and_sees_the_highlighted_object(served_map: Path, tmp_path
         assert "chosen" in driver.find_element(By.ID, "obj-1").get_attribute("class")
         runners = driver.find_elements(By.CSS_SELECTOR, "#runners li")
         assert runners and all(r.get_attribute("id") != "runner-1" for r in runners)
+        for r in runners:  # every number labelled, every runner-up with why it lost
+            assert "caption similarity 0." in r.text and "Not chosen: " in r.text and "(0.00)" not in r.text
         assert driver.find_elements(By.CSS_SELECTOR, "svg polyline.path")  # the planned path from the robot
         assert "Path:" in driver.find_element(By.ID, "chosen-goal").text
         driver.save_screenshot(str(tmp_path / "page.png"))
@@ -53,3 +55,26 @@ def test_browser_asks_and_sees_the_highlighted_object(served_map: Path, tmp_path
         wait.until(lambda d: d.find_element(By.ID, "status").text.startswith("error:"))
         assert "no words" in driver.find_element(By.ID, "status").text
         assert not driver.find_element(By.ID, "chosen").is_displayed()
+
+
+def test_browser_picks_the_map(served_map: Path, tmp_path: Path) -> None:
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import Select, WebDriverWait
+
+    from capnav.io.mapfile import load_map, save_map
+
+    cmap = load_map(served_map)
+    cmap.objects = cmap.objects[:-2]
+    other = save_map(cmap, tmp_path / "upstairs.capnav")
+    with running_server([served_map, other]) as url, chromium() as driver:
+        driver.get(url + "/")
+        wait = WebDriverWait(driver, 30)
+        wait.until(lambda d: d.find_element(By.TAG_NAME, "body").get_attribute("data-ready") == "1")
+        assert len(driver.find_elements(By.CSS_SELECTOR, "svg rect.obj")) == 7
+        Select(driver.find_element(By.ID, "mapsel")).select_by_value("upstairs")
+        wait.until(lambda d: "upstairs.capnav: 5 objects" in d.find_element(By.ID, "mapinfo").text)
+        assert len(driver.find_elements(By.CSS_SELECTOR, "svg rect.obj")) == 5
+        driver.find_element(By.ID, "q").send_keys("the red sofa")
+        driver.find_element(By.ID, "go").click()
+        wait.until(lambda d: d.find_element(By.ID, "chosen-id").text == "1")
+        assert driver.find_elements(By.CSS_SELECTOR, "svg polyline.path")

@@ -65,11 +65,18 @@ def register(app: typer.Typer) -> None:
                     raise InputError(f"{map_path} was embedded with {sorted(models)}; pass --embedder and "
                                      "--embedder-path for that model")
             emb = pending.result()
+        robot_note = ""
+        if xy is not None:  # off the map: an error, as for navigate; in an obstacle: the nearest free cell
+            from capnav.planning.position import place_robot
+
+            xy, robot_note = place_robot(cmap.occupancy, xy, "--robot")
         cfg = RetrievalConfig(use_verifier=verifier != "none", use_attribute_heuristic=heuristic)
         res: QueryResult = Retriever(cmap, emb, create_verifier(verifier), cfg).query(instruction, robot_xy=xy)
         if as_json:
-            typer.echo(json.dumps(res.to_dict(), indent=2))
+            typer.echo(json.dumps(res.to_dict() | ({"robot_note": robot_note} if robot_note else {}), indent=2))
         else:
+            if robot_note:
+                typer.echo(f"note: {robot_note}", err=True)
             _print(res)
         # Answered "not found": exit code 1, as `capnav navigate` when not reached. With --json the
         # answer is in the payload ("found": false) and a printed answer exits 0, so that scripts

@@ -1,13 +1,17 @@
-"""``capnav serve MAP``: keep one map loaded behind a web page and JSON endpoints (loopback only
-unless ``--host`` says otherwise)."""
+"""``capnav serve MAP [MAP ...]``: keep maps loaded behind a web page and JSON endpoints (loopback
+only unless ``--host`` says otherwise, and then only with a bearer token)."""
 
 from __future__ import annotations
 
 import ipaddress
+import os
+import sys
 from pathlib import Path
 from typing import Annotated
 
 import typer
+
+TOKEN_ENV = "CAPNAV_SERVE_TOKEN"
 
 
 def is_loopback(host: str) -> bool:
@@ -22,18 +26,35 @@ def is_loopback(host: str) -> bool:
 def register(app: typer.Typer) -> None:
     @app.command("serve")
     def serve_cmd(
-        map_path: Annotated[Path, typer.Argument(help="a captioned map (capnav map + capnav caption)")],
-        host: Annotated[str, typer.Option(help="address to listen on; anything but loopback exposes the map "
-                                               "to your network")] = "127.0.0.1",
+        map_paths: Annotated[list[Path], typer.Argument(
+            help="captioned maps (capnav map + capnav caption); each is served under its file name, the first "
+                 "also on the unnamed routes")],
+        host: Annotated[str, typer.Option(help="address to listen on; anything but loopback exposes the maps "
+                                               "to your network and needs --token")] = "127.0.0.1",
         port: Annotated[int, typer.Option(min=0, max=65535, help="TCP port (0: any free one)")] = 8765,
+        token: Annotated[str | None, typer.Option(
+            help=f"bearer token every /api request must carry (default: ${TOKEN_ENV}); required off loopback")
+                         ] = None,
+        workers: Annotated[int, typer.Option(min=1, max=64, help="worker threads that answer asks")] = 2,
+        queue: Annotated[int, typer.Option(min=0, help="asks that may wait for a worker (more: 503)")] = 32,
+        time_limit: Annotated[float, typer.Option(min=0.01, help="seconds an ask may take (else 503)")] = 10.0,
+        body_timeout: Annotated[float, typer.Option(min=0.01, help="seconds to receive a request body")] = 10.0,
+        header_timeout: Annotated[float, typer.Option(min=0.01, help="seconds to receive request headers")] = 10.0,
         rate: Annotated[float, typer.Option(min=0.0, help="requests per second per client (0: no limit)")] = 50.0,
         burst: Annotated[int, typer.Option(min=1, help="requests a client may send at once")] = 100,
         max_body: Annotated[int, typer.Option(min=256, help="largest request body in bytes")] = 16_384,
+        access_log: Annotated[bool, typer.Option("--access-log", help="one log line per request (method, path, "
+                                                                      "status, ms)")] = False,
         verifier: Annotated[str, typer.Option(help="offline | none | gemini | openai | hf-local")] = "offline",
         embedder: Annotated[str, typer.Option(help="auto (the map's model) or a backend name")] = "auto",
         embedder_path: Annotated[Path | None, typer.Option(help="local model folder for other embedders")] = None,
     ) -> None:
-        """Serve a map: a page to ask it in words and see the answer on the map, plus a JSON API."""
+        """Serve maps: a page to ask them in words and see the answer on the map, plus a JSON API.
+        SIGHUP or POST /api/reload re-reads map files replaced on disk; SIGTERM finishes the asks
+        in progress and stops."""
+        import logging
+        import threading
+
         from rich.console import Console
 
         from capnav.core.errors import InputError
@@ -41,16 +62,58 @@ def register(app: typer.Typer) -> None:
         try:
             import uvicorn
 
-            from capnav.api import CapNav
             from capnav.serve import ServeConfig, create_app
+            from capnav.serve.maps import AskOptions, unique_names
+            from capnav.serve.protocol import Server, header_protocol
         except ImportError as e:
-            raise InputError(f"capnav serve needs the serve extra: pip install 'capnav[serve]' ({e})") from None
+            raise InputError(f"capnav serve needs the serve extra: {sys.executable} -m pip install "
+                             f"'capnav[serve]' ({e})") from None
         con = Console(stderr=True)
-        nav = CapNav.open(map_path, embedder=embedder, embedder_path=embedder_path, verifier=verifier)
-        nav.embedder  # noqa: B018 - fail here, with one line, when the map cannot be asked
-        app = create_app(nav, ServeConfig(max_body=max_body, rate=rate, burst=burst))
+        token = token or os.environ.get(TOKEN_ENV) or None
+        if not is_loopback(host) and token is None:
+            raise InputError(f"--host {host} is not loopback: anyone who can reach it could read the maps; pass "
+                             f"--token TOKEN (or set {TOKEN_ENV}) so that every /api request needs it")
+        unique_names(map_paths)
+        for p in map_paths:
+            if not p.is_file():
+                raise InputError(f"map file not found: {p}" + (" (a folder: give the .capnav file in it)"
+                                                                if p.is_dir() else ""))
+        cfg = ServeConfig(max_body=max_body, rate=rate, burst=burst, workers=workers, queue=queue,
+                          time_limit=time_limit, body_timeout=body_timeout, token=token, access_log=access_log,
+                          load_in_background=True)
+        opts = AskOptions(embedder, embedder_path, verifier)
+        app = create_app(list(map_paths), cfg, opts)
+        handler = logging.StreamHandler(sys.stderr)
+        handler.setFormatter(logging.Formatter("%(asctime)s %(message)s", "%H:%M:%S"))
+        for name in ("capnav.serve", "capnav.serve.access"):
+            lg = logging.getLogger(name)
+            lg.setLevel(logging.INFO)
+            lg.addHandler(handler)
+            lg.propagate = False
         if not is_loopback(host):
-            con.print(f"[yellow]warning:[/] listening on {host}: anyone who can reach it can read the map",
+            con.print(f"[yellow]warning:[/] listening on {host}: the /api routes need the bearer token",
                       highlight=False)
-        con.print(f"serving {map_path} ({len(nav.map.objects)} objects) on http://{host}:{port}/", highlight=False)
-        uvicorn.run(app, host=host, port=port, log_level="warning")
+        maps = app.state.maps.all()
+        what = ", ".join(f"{m.name} ({len(m.nav.map.objects)} objects)" for m in maps)
+
+        def listening(url: str) -> None:
+            con.print(f"serving {what} on {url}", highlight=False)
+
+            def ready() -> None:
+                try:
+                    app.state.pool.wait_ready()
+                except Exception as e:
+                    con.print(f"[red]error:[/] a worker failed to load: {e}", highlight=False)
+                    return
+                con.print(f"ready: {len(maps)} map(s), {app.state.pool.workers} workers", highlight=False)
+
+            threading.Thread(target=ready, daemon=True).start()
+
+        async def on_hup() -> None:
+            result = await app.state.reload()
+            con.print("SIGHUP: " + "; ".join(f"{k}: {v}" for k, v in result.items()), highlight=False)
+
+        config = uvicorn.Config(app, host=host, port=port, log_level="warning", access_log=False,
+                                http=header_protocol(header_timeout), timeout_keep_alive=5,
+                                timeout_graceful_shutdown=int(max(1.0, time_limit + 5)), lifespan="on")
+        Server(config, listening, on_hup).run()

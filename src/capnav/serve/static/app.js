@@ -5,6 +5,29 @@ const $ = (id) => document.getElementById(id);
 let info = null;      // /api/map
 let objects = [];     // /api/objects
 let robot = null;     // [x, y] world metres
+let base = "/api";    // the chosen map's routes: /api (the first map) or /api/maps/NAME
+let shown = [];       // object URLs of fetched pictures, revoked when replaced
+
+// A server off loopback needs its bearer token: open the page as /#token=TOKEN.
+const token = (() => {
+  const m = location.hash.match(/token=([^&]+)/);
+  if (m) sessionStorage.setItem("capnav-token", decodeURIComponent(m[1]));
+  return sessionStorage.getItem("capnav-token");
+})();
+
+function get(path, opts = {}) {
+  const headers = Object.assign({}, opts.headers || {});
+  if (token) headers.Authorization = "Bearer " + token;
+  return fetch(path, Object.assign({}, opts, {headers: headers}));
+}
+
+async function picture(img, path) {  // <img> src through fetch, so the token goes with it
+  const r = await get(path);
+  if (!r.ok) { img.hidden = true; return; }
+  const url = URL.createObjectURL(await r.blob());
+  shown.push(url);
+  img.src = url;
+}
 
 function px(x, y) {  // world (m) -> picture pixels (north up)
   const p = info.picture;
@@ -58,7 +81,7 @@ function show(ans) {
   if (!ans.found) {
     status.textContent = ans.reason;
   } else {
-    const o = ans.object;
+    const o = ans.chosen || ans.object;
     status.textContent = `"${ans.instruction}"`;
     $("chosen").hidden = false;
     $("chosen-id").textContent = o.id;
@@ -66,11 +89,12 @@ function show(ans) {
     $("chosen-caption").textContent = o.caption;
     $("chosen-why").textContent = ans.reason;
     const plan = ans.plan;
-    $("chosen-goal").textContent = plan ? `Path: ${plan.length_m.toFixed(2)} m, ${plan.success ? "ends" : "does NOT end"} within reach (${plan.reason}).`
-                                        : (ans.goal_note || "");
+    const note = ans.robot_note ? `Robot: ${ans.robot_note}. ` : "";
+    $("chosen-goal").textContent = note + (plan ? `Path: ${plan.length_m.toFixed(2)} m, ${plan.success ? "ends" : "does NOT end"} within reach (${plan.reason}).`
+                                                : (ans.plan_note || ans.goal_note || ""));
     const img = $("chosen-view");
     img.hidden = !o.views.length;
-    if (o.views.length) img.src = `/api/objects/${o.id}/view.png`;
+    if (o.views.length) picture(img, `${base}/objects/${o.id}/view.png`);
     $(`obj-${o.id}`)?.classList.add("chosen");
     if (plan && plan.poses.length > 1) {
       const pts = plan.poses.map((p) => px(p[0], p[1]).join(",")).join(" ");
@@ -85,11 +109,15 @@ function show(ans) {
     const li = document.createElement("li");
     li.id = "runner-" + r.id;
     const b = document.createElement("b");
-    b.textContent = `object ${r.id}`;
+    b.textContent = `object ${r.id} (${r.category})`;
     const s = document.createElement("span");
     s.className = "score";
-    s.textContent = ` (${r.score.toFixed(2)}) `;
-    li.append(b, s, document.createTextNode(r.caption || r.category));
+    const sim = r.terms && r.terms.similarity;  // the caption's cosine similarity, labelled
+    s.textContent = sim === undefined ? " " : ` caption similarity ${sim.toFixed(2)} `;
+    const why = document.createElement("div");
+    why.className = "why";
+    why.textContent = r.why ? `Not chosen: ${r.why}` : "";
+    li.append(b, s, document.createTextNode(r.caption || r.category), why);
     list.appendChild(li);
     $(`obj-${r.id}`)?.classList.add("runner");
   }
@@ -106,8 +134,8 @@ async function ask(ev) {
   const body = {text: text, k: Number.isFinite(k) ? k : 5};
   if (robot) body.robot = robot;
   try {
-    const r = await fetch("/api/query", {method: "POST", headers: {"Content-Type": "application/json"},
-                                         body: JSON.stringify(body)});
+    const r = await get(`${base}/query`, {method: "POST", headers: {"Content-Type": "application/json"},
+                                          body: JSON.stringify(body)});
     const data = await r.json();
     if (!r.ok) {
       clearAnswer();
@@ -132,16 +160,44 @@ function place(ev) {
   drawRobot();
 }
 
-async function init() {
-  const [m, o] = await Promise.all([fetch("/api/map"), fetch("/api/objects")]);
+async function load() {  // the chosen map: its picture, objects and default robot
+  const [m, o] = await Promise.all([get(`${base}/map`), get(`${base}/objects`)]);
+  if (!m.ok) {
+    $("mapinfo").textContent = `error: ${(await m.json()).error || m.status}`;
+    return;
+  }
   info = await m.json();
   objects = (await o.json()).objects;
   robot = info.default_robot;
+  for (const u of shown.splice(0)) URL.revokeObjectURL(u);
+  await picture($("mapimg"), `${base}/map.png`);
   $("mapinfo").textContent = `${info.source || "map"}: ${info.objects} objects` +
     (info.captioned ? "" : " (not captioned: run capnav caption first)");
   drawObjects();
+  clearAnswer();
+  $("status").textContent = "";
+}
+
+async function init() {
+  const r = await get("/api/maps");
+  if (r.ok) {
+    const maps = await r.json();
+    const sel = $("mapsel");
+    for (const m of maps.maps) {
+      const opt = document.createElement("option");
+      opt.value = m.name;
+      opt.textContent = `${m.name} (${m.objects} objects)`;
+      sel.appendChild(opt);
+    }
+    sel.hidden = maps.maps.length < 2;
+    sel.addEventListener("change", async () => {
+      base = `/api/maps/${encodeURIComponent(sel.value)}`;
+      await load();
+    });
+  }
   $("ask").addEventListener("submit", ask);
   $("map").addEventListener("click", place);
+  await load();
   document.body.dataset.ready = "1";
 }
 
