@@ -152,3 +152,12 @@ def test_icl_livingroom_imports_with_no_option(tmp_path: Path) -> None:
     al = DatasetReader(tmp_path / "icl").meta["meta"]["alignment"]
     assert al["nearest_axis"] == "-y" and al["axis_angle_deg"] < 5
     assert 0.7 < al["facts"]["camera_height_median_m"] < 1.3
+
+
+def test_depth_in_the_wrong_scale_warns(tmp_path: Path, frames: list[Frame]) -> None:
+    """Millimetre PNGs read as TUM's 5000 per metre: the cameras come out 0.25 m above the floor."""
+    src = export("open3d", frames, tmp_path / "rec")
+    res = CliRunner().invoke(app, ["import", "open3d", str(src), "-o", str(tmp_path / "ds"), "--depth-scale", "5000",
+                                   "--no-progress"])
+    assert res.exit_code == 0, res.output + repr(res.exception)
+    assert "warning: the cameras are 0.25 m above the floor found" in res.output and "--depth-scale" in res.output

@@ -24,8 +24,8 @@ MaxPoseGap = Annotated[float, typer.Option("--max-pose-gap", help="max gap betwe
 Stride = Annotated[int, typer.Option("--stride", min=1, help="keep every k-th associated frame")]
 MaxFrames = Annotated[int | None, typer.Option("--max-frames", min=1, help="keep only the first N selected frames")]
 Up = Annotated[str, typer.Option("--up", help="'auto' finds up from the floor and the cameras (refuses when unsure); "
-                                              "an axis (+z, -y, ...) is refined by the floor and checked; 'none' "
-                                              "keeps the recorded frame")]
+                                              "an axis (+z, -y, ...) or a direction x,y,z in the recording's frame "
+                                              "is refined by the floor and checked; 'none' keeps the recorded frame")]
 Overwrite = Annotated[bool, typer.Option("--overwrite", help="replace an existing dataset folder")]
 Progress = Annotated[bool, typer.Option(help="show progress")]
 Intrinsics = Annotated[str | None, typer.Option("--intrinsics", help="intrinsics file (default: the layout's own)")]

@@ -6,7 +6,8 @@ heights need the floor at z = 0, so the importer finds a rigid transform ``A`` a
 ``T_wc' = A @ T_wc`` for every frame. By default up is found from the recording itself
 (``capnav.io.up_axis``: the floor, the cameras' height over it and how they are held); a user may
 name the approximate axis instead, which is checked against the same evidence. The floor is the
-lowest well-supported plane facing up, not a table top. Yaw and the horizontal origin stay as
+lowest well-supported plane facing up with the cameras at a carried height above it, not
+the plane with the most points (a table top under a camera looking down at it). Yaw and the horizontal origin stay as
 recorded.
 """
 
@@ -29,14 +30,23 @@ UP_CHOICES = ("auto", *AXES, "none")
 
 
 def parse_up(up: str) -> NDArray[np.float64] | None:
-    """The up axis named by ``--up`` (``+z``, ``-y``, ``y`` = ``+y``, ...) or None for ``none`` / ``auto``."""
+    """The up direction named by ``--up``: an axis (``+z``, ``-y``, ``y`` = ``+y``, ...) or any direction
+    ``x,y,z`` in the recording's frame (normalised); None for ``none`` / ``auto``."""
     key = up.strip().lower()
     if key in ("none", "auto"):
         return None
+    if "," in key:
+        try:
+            v = np.array([float(t) for t in key.split(",")], dtype=np.float64)
+        except ValueError:
+            raise InputError(f"--up x,y,z needs three numbers, got {up!r}") from None
+        if v.shape != (3,) or not np.isfinite(v).all() or np.linalg.norm(v) < 1e-9:
+            raise InputError(f"--up x,y,z needs three finite numbers, not all 0, got {up!r}")
+        return v / np.linalg.norm(v)
     if len(key) == 1:
         key = "+" + key
     if key not in AXES:
-        raise InputError(f"--up must be one of {', '.join(UP_CHOICES)}, got {up!r}")
+        raise InputError(f"--up must be one of {', '.join(UP_CHOICES)} or a direction x,y,z, got {up!r}")
     return np.array(AXES[key])
 
 
@@ -108,7 +118,10 @@ def floor_alignment(views: Iterable[tuple[NDArray[np.floating], NDArray[np.float
                              "axis_angle_deg": round(ang, 3), "tilt_from_up_deg": round(ang if u is None else
                                                                                           angle_deg(c.up, u), 3),
                              "confidence": round(res.confidence, 4), "floor_points": c.floor_points,
-                             "floor_rms_m": c.floor_rms_m, "cues": {k: round(v, 4) for k, v in c.cues.items()},
+                             "floor_rms_m": c.floor_rms_m, "floor_confidence": round(c.facts["floor_confidence"], 4),
+                             "floor_runner_up": None if c.runner_up_plane is None else
+                             {k: round(v, 4) for k, v in c.runner_up_plane.items()},
+                             "cues": {k: round(v, 4) for k, v in c.cues.items()},
                              "facts": {k: round(v, 4) for k, v in c.facts.items()}, "search": res.to_meta()})
 
 

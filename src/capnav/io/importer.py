@@ -81,6 +81,15 @@ class ImportReport:
                        + f"); floor {a['floor_points']} points ({100 * f['floor_share']:.0f}%), rms "
                        f"{100 * a['floor_rms_m']:.1f} cm, cameras {f['camera_height_median_m']:.2f} m above it, "
                        f"image-down {f['upright_deg']:.0f} deg from gravity")
+            r = a.get("floor_runner_up")
+            out.append(f"floor confidence {a['floor_confidence']:.2f} ({f['floor_area_m2']:.1f} m2 seen); "
+                       + ("no other plane faces up" if r is None else
+                          f"runner-up plane {r['height_m']:+.2f} m above the floor: {int(r['points'])} points "
+                          f"({r['points'] / max(a['floor_points'], 1):.1f}x the floor's), {r['area_m2']:.1f} m2"))
+            h, (lo, hi) = f["camera_height_median_m"], UpConfig().usual_height
+            if not lo <= h <= hi:
+                out.append(f"warning: the cameras are {h:.2f} m above the floor found, an implausible height for a "
+                           "hand-held or robot camera: is the depth scale right (--depth-scale: units per metre)?")
         else:
             out.append("world frame kept as recorded (--up none)")
         for reason, n in self.skipped.counts().items():

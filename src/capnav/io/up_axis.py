@@ -8,8 +8,9 @@ made by a person or a robot. For a candidate up direction ``n`` and the floor pl
 - support: the floor holds a fair share of the depth points (the floor is large);
 - below / cameras: almost no point lies under it, and the cameras are above it at a height a
   hand or a robot holds a camera (the floor is the lowest surface and lies below the cameras);
-- upright: the cameras' image-down axis points along ``-n`` (image rows are held level: gravity
-  is perpendicular to the floor);
+- upright: the cameras hold their image rows level (perpendicular to ``n``) and their image-down
+  axis has a share along ``-n`` (a camera may look down at a table steeply, but not straight down,
+  where image rows say nothing about gravity);
 - level: the cameras move far less along ``n`` than across it (they travel at a constant height;
   no information when they hardly move).
 
@@ -49,13 +50,15 @@ class UpConfig:
     max_candidates: int = 8
     inlier_dist: float = 0.03  # m from the floor plane
     min_points: int = 200  # a plane needs this many sampled points (or 2% of them, when fewer than 10000)
-    min_support: float = 0.2  # a lower plane is the floor when it has this share of the biggest one's points
+    min_plane_area: float = 0.5  # m^2 it must cover (0.2 m cells), so a small step or box top is not the floor
     support_full: float = 0.05  # floor share of all points at which the support cue is 1
     below_tol: float = 0.10  # m under the floor before a point counts as below it (depth noise)
     below_fail: float = 0.10  # share of points below the floor at which the below cue is 0
     camera_height: tuple[float, float] = (0.05, 3.0)  # m above the floor a camera is carried at
+    usual_height: tuple[float, float] = (0.3, 2.5)  # m; outside it the import warns (a wrong depth scale?)
     cameras_full: float = 0.95  # share of cameras at such a height for a full cue (0 at 0.8)
-    upright_range: tuple[float, float] = (0.25, 0.75)  # cos(image-down, gravity): cue 0 .. 1
+    down_range: tuple[float, float] = (0.1, 0.3)  # cos(image-down, gravity): cue 0 .. 1 (pitch 84 .. 72.5 deg)
+    roll_range_deg: tuple[float, float] = (30.0, 12.0)  # image rows' angle to level: cue 0 .. 1
     level_ratio: tuple[float, float] = (0.2, 0.6)  # height spread / horizontal spread: cue 1 .. 0
     level_min_travel: float = 0.3  # m of horizontal spread below which the level cue says nothing
     distinct_deg: float = 20.0  # the runner-up must differ by more than this from the choice
@@ -76,6 +79,7 @@ class UpCandidate:
     floor_rms_m: float
     cues: dict[str, float]
     facts: dict[str, float]
+    runner_up_plane: dict[str, float] | None = None  # the biggest other plane facing along ``up``
 
     @property
     def fit(self) -> float:
@@ -103,7 +107,9 @@ class UpCandidate:
                 "nearest_axis": axis, "axis_angle_deg": round(ang, 2), "fit": round(self.fit, 4),
                 "cues": {k: round(v, 4) for k, v in self.cues.items()},
                 "facts": {k: round(v, 4) for k, v in self.facts.items()},
-                "floor_points": self.floor_points, "floor_rms_m": round(self.floor_rms_m, 5)}
+                "floor_points": self.floor_points, "floor_rms_m": round(self.floor_rms_m, 5),
+                "runner_up_plane": None if self.runner_up_plane is None else
+                {k: round(v, 4) for k, v in self.runner_up_plane.items()}}
 
 
 @dataclass
@@ -201,29 +207,83 @@ def need_points(n: int, cfg: UpConfig) -> int:
     return min(cfg.min_points, max(30, n // 50))
 
 
-def floor_along(points: F64, normals: F64, n: F64, cfg: UpConfig) -> tuple[F64, float, int, float] | None:
-    """The floor for up ``n``: the lowest plane facing along ``n`` with at least ``min_support`` of
-    the biggest such plane's points (so a table top loses to the floor under it), refitted by least
-    squares. Returns ``(normal, offset, inliers, rms)`` or None when no plane faces that way."""
+@dataclass
+class FloorFit:
+    """The floor found along an up direction, and the biggest other horizontal plane (the runner-up)."""
+
+    normal: F64
+    offset: float
+    points: int
+    rms: float
+    area_m2: float
+    confidence: float  # how well the chosen plane is supported: the area it covers, the cameras above it
+    runner_up: dict[str, float] | None  # height above the floor, points, area of the next plane
+
+
+def plane_peaks(h: F64, cfg: UpConfig) -> list[tuple[float, int]]:
+    """Heights of the horizontal planes in sorted point heights ``h``: local maxima of the number of
+    points within ``inlier_dist``, at least ``2 inlier_dist`` apart, with their support, lowest first."""
+    from scipy.ndimage import maximum_filter1d
+
+    tol, step = cfg.inlier_dist, cfg.inlier_dist / 2
+    grid = np.arange(h[0], h[-1] + step, step)
+    support = np.searchsorted(h, grid + tol) - np.searchsorted(h, grid - tol)
+    w = 2 * round(2 * tol / step) + 1
+    top = np.flatnonzero((support == maximum_filter1d(support, size=w, mode="constant")) & (support > 0))
+    peaks: list[tuple[float, int]] = []
+    for i in top[np.argsort(-support[top], kind="stable")]:
+        if all(abs(grid[i] - g) > 2 * tol for g, _ in peaks):
+            peaks.append((float(grid[i]), int(support[i])))
+    return sorted(peaks)
+
+
+def plane_area(P: F64, n: F64, cell: float = 0.2) -> float:
+    """Area (m^2) of the ``cell``-sized squares the points ``P`` of a plane with normal ``n`` cover."""
+    if len(P) == 0:
+        return 0.0
+    e1 = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(n, e1)
+    ij = np.floor(np.stack([P @ e1, P @ e2], axis=1) / cell).astype(np.int64)
+    return float(len(np.unique(ij, axis=0))) * cell * cell
+
+
+def floor_along(points: F64, normals: F64, n: F64, poses: NDArray[np.floating] | None,
+                cfg: UpConfig) -> FloorFit | None:
+    """The floor for up ``n``: the lowest well-supported plane facing along ``n`` (``need_points``
+    points covering ``min_plane_area``) with most cameras at a carried height above it, not the
+    plane with the most points (a table top, counter or bed under a camera looking down at it holds
+    far more: the floor may show only at the image edges). Refitted by least squares; None when no
+    plane faces that way."""
     n = np.asarray(n, dtype=np.float64) / np.linalg.norm(n)
     cos_f = np.cos(np.radians(cfg.facing_deg))
-    tol, step = cfg.inlier_dist, cfg.inlier_dist / 2
+    tol = cfg.inlier_dist
     need = need_points(len(points), cfg)
-    off, inl = 0.0, np.zeros(0, dtype=bool)
+    C = None if poses is None else np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)[:, :3, 3]
+    lo, hi = cfg.camera_height
+    off, area, runner, carried = 0.0, 0.0, None, 1.0
     for _ in range(3):
         with np.errstate(invalid="ignore"):
             facing = np.nan_to_num(normals @ n, nan=-1.0) >= cos_f
         if facing.sum() < need:
             return None
-        h = np.sort(points[facing] @ n)
-        grid = np.arange(h[0], h[-1] + step, step)
-        support = np.searchsorted(h, grid + tol) - np.searchsorted(h, grid - tol)
-        best = int(support.max())
-        if best < need:
+        Pf = points[facing]
+        hf = Pf @ n
+        peaks = plane_peaks(np.sort(hf), cfg)
+        sized = [(g, c, plane_area(Pf[np.abs(hf - g) < tol], n)) for g, c in peaks if c >= need]
+        if not sized:
             return None
-        first = int(np.flatnonzero(support >= max(cfg.min_support * best, need))[0])
-        peak = first + int(np.argmax(support[first: first + int(2 * tol / step) + 1]))
-        off = float(grid[peak])
+        good = [p for p in sized if p[2] >= cfg.min_plane_area] or [max(sized, key=lambda p: p[1])]
+        share = [1.0 if C is None else float(np.mean((C @ n - g > lo) & (C @ n - g < hi))) for g, _, _ in good]
+        pick = next((i for i, sh in enumerate(share) if sh >= 0.5), 0)
+        off, _, area = good[pick]
+        carried = share[pick]
+        others = [p for p in sized if abs(p[0] - off) > 2 * tol]
+        big = max(others, key=lambda p: p[1]) if others else None
+        runner = None
+        if big is not None:  # heights from the planes' points, not the peak search's grid
+            dh = float(np.median(hf[np.abs(hf - big[0]) < tol]) - np.median(hf[np.abs(hf - off) < tol]))
+            runner = {"height_m": dh, "points": float(big[1]), "area_m2": big[2]}
         inl = facing & (np.abs(points @ n - off) < tol)
         P = points[inl]
         c = P.mean(axis=0)
@@ -232,7 +292,8 @@ def floor_along(points: F64, normals: F64, n: F64, cfg: UpConfig) -> tuple[F64, 
         off = float(n @ c)
     inl = np.abs(points @ n - off) < tol
     rms = float(np.sqrt(np.mean((points[inl] @ n - off) ** 2))) if inl.any() else float("nan")
-    return n, off, int(inl.sum()), rms
+    conf = min(_ramp(area, cfg.min_plane_area, 4 * cfg.min_plane_area), _ramp(carried, 0.5, cfg.cameras_full))
+    return FloorFit(n, off, int(inl.sum()), rms, area, conf, runner)
 
 
 def _ramp(x: float, zero: float, one: float) -> float:
@@ -252,6 +313,7 @@ def score(points: F64, n: F64, offset: float, poses: NDArray[np.floating], cfg: 
     lo, hi = cfg.camera_height
     carried = float(np.mean((hc > lo) & (hc < hi)))
     upright = float(np.median(T[:, :3, 1] @ -n))  # image-down axis against gravity (-n)
+    roll = float(np.degrees(np.arcsin(np.clip(np.median(np.abs(T[:, :3, 0] @ n)), 0.0, 1.0))))  # rows vs level
     across = C - np.outer(C @ n, n)
     travel = float(np.sqrt(np.sum(np.var(across, axis=0))))
     height_sd = float(np.std(hc))
@@ -259,23 +321,24 @@ def score(points: F64, n: F64, offset: float, poses: NDArray[np.floating], cfg: 
     level = 1.0 if travel < cfg.level_min_travel else _ramp(ratio, cfg.level_ratio[1], cfg.level_ratio[0])
     cues = {"support": _ramp(floor_share, 0.0, cfg.support_full), "below": _ramp(below, cfg.below_fail, 0.0),
             "cameras": _ramp(carried, 0.8, cfg.cameras_full),
-            "upright": _ramp(upright, cfg.upright_range[0], cfg.upright_range[1]), "level": level}
+            "upright": min(_ramp(upright, *cfg.down_range), _ramp(roll, *cfg.roll_range_deg)), "level": level}
     facts = {"floor_share": floor_share, "below_share": below, "cameras_carried": carried,
              "camera_height_median_m": float(np.median(hc)), "camera_height_sd_m": height_sd,
              "camera_travel_m": travel, "upright_cos": upright,
-             "upright_deg": float(np.degrees(np.arccos(np.clip(upright, -1.0, 1.0))))}
+             "upright_deg": float(np.degrees(np.arccos(np.clip(upright, -1.0, 1.0)))), "roll_deg": roll}
     return cues, facts
 
 
 def evaluate(points: F64, normals: F64, n: F64, poses: NDArray[np.floating], source: str,
              cfg: UpConfig) -> UpCandidate | None:
     """The candidate for up near ``n`` (its floor refined), or None when no plane faces along ``n``."""
-    fl = floor_along(points, normals, n, cfg)
+    fl = floor_along(points, normals, n, poses, cfg)
     if fl is None:
         return None
-    up, off, k, rms = fl
-    cues, facts = score(points, up, off, poses, cfg)
-    return UpCandidate(up, off, source, k, rms, cues, facts)
+    cues, facts = score(points, fl.normal, fl.offset, poses, cfg)
+    facts["floor_area_m2"] = fl.area_m2
+    facts["floor_confidence"] = fl.confidence
+    return UpCandidate(fl.normal, fl.offset, source, fl.points, fl.rms, cues, facts, fl.runner_up)
 
 
 def camera_directions(poses: NDArray[np.floating], cfg: UpConfig) -> list[tuple[F64, str]]:
@@ -351,8 +414,9 @@ def cue_words(cue: str, f: dict[str, float]) -> str:
         "below": f"{100 * f['below_share']:.0f}% of the depth points lie below that floor",
         "cameras": f"only {100 * f['cameras_carried']:.0f}% of the cameras are 0.05-3 m above it "
                    f"(median {f['camera_height_median_m']:+.2f} m)",
-        "upright": f"the image-down axis is {f['upright_deg']:.0f} deg from that gravity, so the image rows "
-                   "would not be level",
+        "upright": (f"the image rows would be {f['roll_deg']:.0f} deg from level" if f["roll_deg"] > 20 else
+                    f"the image-down axis is {f['upright_deg']:.0f} deg from that gravity, so the image rows "
+                    "would not tell which way is down"),
         "level": f"the cameras move {f['camera_height_sd_m']:.2f} m up and down over {f['camera_travel_m']:.2f} m "
                  "across",
     }[cue]
