@@ -118,7 +118,7 @@ def test_version_1_without_trajectory_loads(cmap: CapNavMap, tmp_path: Path) -> 
     p = save_map(old, tmp_path / "m.capnav")
     with zipfile.ZipFile(p) as zf:
         assert not [n for n in zf.namelist() if n.startswith("trajectory/")]
-    v1 = _edited_copy(p, tmp_path / "v1.capnav", "header.json", lambda d: d.replace(b'"version": 3', b'"version": 1'))
+    v1 = _edited_copy(p, tmp_path / "v1.capnav", "header.json", lambda d: d.replace(b'"version": 4', b'"version": 1'))
     back = load_map(v1)
     assert back.trajectory is None and len(back.objects) == len(cmap.objects)
 
@@ -133,7 +133,7 @@ def test_float32_features_and_version_2_files(cmap: CapNavMap, tmp_path: Path) -
         for info in zin.infolist():
             data = zin.read(info.filename)
             if info.filename == "header.json":
-                data = data.replace(b'"version": 3', b'"version": 2')
+                data = data.replace(b'"version": 4', b'"version": 2')
             zout.writestr(info.filename, data, compress_type=zipfile.ZIP_STORED)
     back = load_map(v2)
     assert back.voxels.features.tobytes() == cmap.voxels.features.tobytes()
@@ -156,7 +156,7 @@ def test_float16_is_smaller_and_out_of_range_features_stay_float32(cmap: CapNavM
 def test_wrong_version_and_foreign_files(cmap: CapNavMap, tmp_path: Path) -> None:
     p = save_map(cmap, tmp_path / "m.capnav")
     bad = _edited_copy(p, tmp_path / "v9.capnav", "header.json",
-                       lambda d: d.replace(b'"version": 3', b'"version": 9'))
+                       lambda d: d.replace(b'"version": 4', b'"version": 9'))
     with pytest.raises(MapFileError, match="version 9"):
         load_map(bad)
     txt = tmp_path / "x.capnav"

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import re
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -52,6 +54,17 @@ def register(app: typer.Typer) -> None:
         max_frames: MaxFrames = None,
         strict: bool = typer.Option(False, help="stop at the first bad frame instead of skipping it"),
         progress: bool = typer.Option(True, help="show a progress bar"),
+        update: Path | None = typer.Option(
+            None, "--update", metavar="MAP",
+            help="fuse DATASET, a later recording of the same home, into MAP (objects keep their ids, moved "
+                 "ones gain a pose history, ones whose place is observed empty retire, new ones are born) and "
+                 "write the result to -o (docs/change.md)"),
+        transform: str | None = typer.Option(
+            None, "--transform", metavar="X,Y,YAW|FILE",
+            help="with --update: DATASET's world frame in MAP's (x, y metres, yaw degrees, or a JSON file with "
+                 "a 4x4 matrix); ICP refines it (default: identity)"),
+        icp: bool = typer.Option(True, "--icp/--no-icp", help="with --update: refine the registration by ICP on "
+                                                            "the depth (Open3D); --no-icp only checks it"),
     ) -> None:
         """Detect, fuse the semantic voxel map, track objects and write the map file."""
         from rich.console import Console
@@ -65,6 +78,8 @@ def register(app: typer.Typer) -> None:
 
         check_output_file(output, "-o")  # fail on an unwritable output and a bad folder before any model loads
         options = parse_detector_options(detector_option)
+        if update is None and (transform is not None or not icp):
+            raise InputError("--transform and --no-icp belong to --update MAP")
         reader = DatasetReader(dataset)
         kwargs = {"noise": noise, "seed": seed, **options} if detector == "sim" else options
         try:
@@ -73,6 +88,9 @@ def register(app: typer.Typer) -> None:
             raise InputError(f"detector {detector!r} rejected its options {sorted(options)}: {e}") from None
         enc = create_encoder(encoder, embedder=create_embedder(embedder))
         cfg = MapperConfig(on_bad_frame="raise" if strict else "skip")
+        if update is not None:
+            _update(update, reader, output, det, enc, cfg, transform, icp, progress)
+            return
         on_interrupt(f"no map was written ({output} is as it was)")
         t0 = time.perf_counter()
         cmap = map_dataset(reader, det, enc, cfg, max_frames=max_frames, progress=progress)
@@ -97,6 +115,67 @@ def register(app: typer.Typer) -> None:
                    "the detector found nothing it keeps in these frames (try a lower score_threshold, "
                    "or another --detector)")
             con.print(f"[yellow]warning:[/] the map has 0 objects: {why}", highlight=False)
+
+
+def _parse_transform(text: str) -> Any:
+    """``X,Y,YAW`` (metres, metres, degrees) or a JSON file holding a 4x4 matrix."""
+    import numpy as np
+
+    from capnav.core.errors import InputError
+    from capnav.core.jsonfile import read_json_object
+
+    p = Path(text)
+    if p.is_file():
+        data = read_json_object(p, "transform file")
+        try:
+            T = np.asarray(data.get("transform"), dtype=np.float64)
+        except (TypeError, ValueError):
+            T = np.zeros(0)
+        if T.shape != (4, 4) or not np.isfinite(T).all() or not np.allclose(T[3], [0, 0, 0, 1]):
+            raise InputError(f"--transform {p}: expected {{\"transform\": a 4x4 rigid matrix (4 rows)}}, got shape "
+                             f"{T.shape}")
+        return T
+    try:
+        x, y, yaw = (float(v) for v in text.split(","))
+    except ValueError:
+        raise InputError(f"--transform must be X,Y,YAW (metres, metres, degrees) or a JSON file, "
+                         f"got {text!r}") from None
+    c, s = np.cos(np.radians(yaw)), np.sin(np.radians(yaw))
+    T = np.eye(4)
+    T[:2, :2] = [[c, -s], [s, c]]
+    T[0, 3], T[1, 3] = x, y
+    return T
+
+
+def _update(map_path: Path, reader: Any, output: Path, det: Any, enc: Any, cfg: Any, transform: str | None,
+            icp: bool, progress: bool) -> None:
+    """``capnav map --update MAP DATASET -o OUT``: register, fuse, write atomically under a lock."""
+    from rich.console import Console
+
+    from capnav.cli.options import check_input_path
+    from capnav.io.mapfile import load_map, lock_map, save_map
+    from capnav.mapping.update import check_same_home, register_recording, update_map
+
+    check_input_path(map_path, "map file")
+    init = _parse_transform(transform) if transform is not None else None
+    con = Console(stderr=True)
+    with lock_map(map_path), (lock_map(output) if output.resolve() != map_path.resolve() else _nothing()):
+        cmap = load_map(map_path)
+        check_same_home(cmap, reader, str(map_path))
+        reg = register_recording(cmap, reader, f"{reader.path} to {map_path}", init=init, icp=icp)
+        con.print(f"registered {reader.path} to {map_path} by {reg.method}: {100 * reg.fitness:.0f}% of its depth on "
+                  f"the map's surface, residual {reg.rmse:.3f} m", highlight=False)
+        on_interrupt(f"{output} was not written ({map_path} is as it was)")
+        new, rep = update_map(cmap, reader, det, enc, transform=reg.T, mapper_config=cfg, progress=progress,
+                              registration=reg)
+        save_map(new, output)
+    con.print(f"{output}: {rep.summary()} ({rep.cpu_seconds:.1f} s CPU); run `capnav caption {output} --dataset "
+              f"{reader.path}` for the views and captions of moved and new objects", highlight=False)
+
+
+@contextlib.contextmanager
+def _nothing() -> Iterator[None]:
+    yield
 
 
 def _grouped(skips: list[dict[str, Any]]) -> list[tuple[str, list[Any]]]:

@@ -1,6 +1,6 @@
 """The CapNav map file: one zip archive, no pickle, validated on load.
 
-Layout (format ``capnav-map``, version 3; versions 1 and 2 still load)::
+Layout (format ``capnav-map``, version 4; versions 1 to 3 still load)::
 
     header.json            format, version, and for every other entry: sha256, size, and for
                            arrays their dtype and shape
@@ -12,6 +12,8 @@ Layout (format ``capnav-map``, version 3; versions 1 and 2 still load)::
     voxels/*.npy, occupancy/cells.npy, grids in objects.json / header.json
     trajectory/frames.npy trajectory/poses.npy   (version 2, when the map recorded one) the
                            fused frames' indices and camera-to-world poses (N, 4, 4)
+    retired/objects.json retired/objects/<field>.npy retired/views/...   (version 4, when a later
+                           recording retired objects) the retired objects, laid out like the present
 
 Arrays are ``.npy`` written and read with ``allow_pickle=False``. Loading checks the format name,
 the version, every entry's presence, checksum, dtype and shape, and the cross-array consistency;
@@ -20,6 +22,7 @@ any failure is a ``MapFileError`` that names the file and what is wrong. Writes 
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import hashlib
 import io
@@ -27,6 +30,7 @@ import json
 import warnings
 import zipfile
 import zlib
+from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
@@ -41,11 +45,12 @@ from capnav.mapping.objects import MapObject, ObjectView, Observation
 from capnav.mapping.voxel_map import VoxelMap
 
 FORMAT = "capnav-map"
-VERSION = 3
+VERSION = 4
 # version 1: no trajectory/; version 2: voxel features always float32 and arrays stored
 # uncompressed; version 3: voxel features float16 by default (``save_map(feature_dtype=...)``) and
 # arrays DEFLATE-compressed (level 1: 4x on an apartment's features, ~0.1 s to inflate).
-READS = (1, 2, 3)
+# version 4: objects carry ``last_seen`` and ``history`` and the map its ``retired`` objects (map updates).
+READS = (1, 2, 3, 4)
 FEATURE_DTYPES = ("float16", "float32")
 _F16_MAX = float(np.finfo(np.float16).max)
 _OBJ_FIELDS = [f.name for f in dataclasses.fields(MapObject)]
@@ -67,7 +72,7 @@ def _json(obj: Any, what: str) -> bytes:
         raise MapFileError(f"cannot save the map: {what} is not JSON-serialisable ({e})") from None
 
 
-def _encode_objects(objects: list[MapObject]) -> tuple[list[dict[str, Any]], dict[str, bytes]]:
+def _encode_objects(objects: list[MapObject], prefix: str = "") -> tuple[list[dict[str, Any]], dict[str, bytes]]:
     records: list[dict[str, Any]] = []
     blobs: dict[str, bytes] = {}
     arrays: dict[str, list[NDArray[Any]]] = {}
@@ -90,7 +95,7 @@ def _encode_objects(objects: list[MapObject]) -> tuple[list[dict[str, Any]], dic
                     d = dataclasses.asdict(v)
                     for kind in ("frame_png", "crop_png"):
                         data = d.pop(kind)
-                        key = f"views/{n}_{k}_{kind[:-4]}.png"
+                        key = f"{prefix}views/{n}_{k}_{kind[:-4]}.png"
                         d[kind] = key if data else None
                         if data:
                             blobs[key] = bytes(data)
@@ -101,7 +106,7 @@ def _encode_objects(objects: list[MapObject]) -> tuple[list[dict[str, Any]], dic
         records.append(rec)
     for name, dtype in _ARRAY_DTYPES.items():
         parts = arrays.get(name, [])
-        blobs[f"objects/{name}.npy"] = _npy(np.concatenate(parts) if parts else np.zeros(0, dtype=dtype))
+        blobs[f"{prefix}objects/{name}.npy"] = _npy(np.concatenate(parts) if parts else np.zeros(0, dtype=dtype))
     return records, blobs
 
 
@@ -135,6 +140,10 @@ def save_map(cmap: CapNavMap, path: str | Path, feature_dtype: str = "float16") 
         blobs["trajectory/frames.npy"] = _npy(cmap.trajectory.frames)
         blobs["trajectory/poses.npy"] = _npy(cmap.trajectory.poses)
     blobs["objects.json"] = _json(records, "an object field")
+    if cmap.retired:
+        old, old_blobs = _encode_objects(cmap.retired, "retired/")
+        blobs.update(old_blobs)
+        blobs["retired/objects.json"] = _json(old, "a retired object's field")
     blobs["meta.json"] = _json(cmap.meta, "meta")
     blobs["caches.json"] = _json(cmap.caches, "caches")
     entries: dict[str, dict[str, Any]] = {}
@@ -270,11 +279,27 @@ def _decode(r: _Reader, header: dict[str, Any], with_voxels: bool = True) -> Cap
                                   feats, proj, str(vh.get("text_space", "")))
     spec = GridSpec(**header["occupancy"])
     occ = OccupancyGrid(spec, r.array("occupancy/cells.npy"))
-    records = r.json("objects.json")
-    if not isinstance(records, list) or len(records) != int(header["n_objects"]):
-        raise r.fail(f"objects.json holds {len(records) if isinstance(records, list) else '?'} objects, "
-                     f"header says {header['n_objects']}")
-    flat = {name: r.array(f"objects/{name}.npy") for name in _ARRAY_DTYPES}
+    objects = _decode_objects(r, "", int(header["n_objects"]))
+    retired = _decode_objects(r, "retired/", None) if "retired/objects.json" in r.entries else []
+    meta = r.json("meta.json")
+    caches = r.json("caches.json")
+    if not isinstance(meta, dict) or not isinstance(caches, dict):
+        raise r.fail("meta.json and caches.json must hold JSON objects")
+    traj = None
+    if "trajectory/poses.npy" in r.entries:
+        traj = CameraTrajectory(r.array("trajectory/frames.npy"), r.array("trajectory/poses.npy"))
+    cmap = CapNavMap(objects=objects, voxels=voxels, occupancy=occ, meta=meta, caches=caches, trajectory=traj,
+                     retired=retired)
+    _check_finite(r, cmap)
+    return cmap
+
+
+def _decode_objects(r: _Reader, prefix: str, n: int | None) -> list[MapObject]:
+    records = r.json(f"{prefix}objects.json")
+    if not isinstance(records, list) or (n is not None and len(records) != n):
+        raise r.fail(f"{prefix}objects.json holds {len(records) if isinstance(records, list) else '?'} objects, "
+                     f"header says {n}")
+    flat = {name: r.array(f"{prefix}objects/{name}.npy") for name in _ARRAY_DTYPES}
     offs = dict.fromkeys(_ARRAY_DTYPES, 0)
     objects: list[MapObject] = []
     for rec in records:
@@ -288,7 +313,7 @@ def _decode(r: _Reader, header: dict[str, Any], with_voxels: bool = True) -> Cap
             size = int(np.prod(shape)) if shape else 1
             chunk = flat[name][offs[name]: offs[name] + size]
             if chunk.size != size:
-                raise r.fail(f"objects/{name}.npy is too short for object {rec.get('id')}")
+                raise r.fail(f"{prefix}objects/{name}.npy is too short for object {rec.get('id')}")
             kw[name] = chunk.reshape(shape).copy()
             offs[name] += size
         for name in _OBJ_FIELDS:
@@ -309,23 +334,14 @@ def _decode(r: _Reader, header: dict[str, Any], with_voxels: bool = True) -> Cap
         objects.append(MapObject(**kw))
     for name, arr in flat.items():
         if offs[name] != arr.size:
-            raise r.fail(f"objects/{name}.npy has {arr.size - offs[name]} values no object claims")
-    meta = r.json("meta.json")
-    caches = r.json("caches.json")
-    if not isinstance(meta, dict) or not isinstance(caches, dict):
-        raise r.fail("meta.json and caches.json must hold JSON objects")
-    traj = None
-    if "trajectory/poses.npy" in r.entries:
-        traj = CameraTrajectory(r.array("trajectory/frames.npy"), r.array("trajectory/poses.npy"))
-    cmap = CapNavMap(objects=objects, voxels=voxels, occupancy=occ, meta=meta, caches=caches, trajectory=traj)
-    _check_finite(r, cmap)
-    return cmap
+            raise r.fail(f"{prefix}objects/{name}.npy has {arr.size - offs[name]} values no object claims")
+    return objects
 
 
 def _check_finite(r: _Reader, cmap: CapNavMap) -> None:
     """Checksums prove the bytes are the ones written, not that they make sense: a NaN position or
     voxel would reach the planner's integer grid maths. Every float array must be finite."""
-    for o in cmap.objects:
+    for o in [*cmap.objects, *cmap.retired]:
         for name in _ARRAY_DTYPES:
             a = getattr(o, name)
             if a is not None and np.asarray(a).dtype.kind == "f" and not np.isfinite(a).all():
@@ -342,3 +358,30 @@ def _check_finite(r: _Reader, cmap: CapNavMap) -> None:
         raise r.fail(f"voxel resolution {vox.resolution} is not a positive number")
     if cmap.trajectory is not None and not np.isfinite(cmap.trajectory.poses).all():
         raise r.fail("trajectory/poses holds NaN or infinite values")
+
+
+@contextlib.contextmanager
+def lock_map(path: str | Path) -> Iterator[None]:
+    """Hold ``<path>.lock`` (an exclusive, non-blocking ``flock``) while a command rewrites a map:
+    a second update of the same map at once is refused instead of racing the first one's write.
+    The lock dies with its process, so a killed update never leaves the map locked."""
+    import fcntl
+    import os
+
+    p = Path(str(path) + ".lock")
+    try:
+        fd = os.open(p, os.O_RDWR | os.O_CREAT, 0o644)
+    except OSError as e:
+        raise MapFileError(f"cannot create the lock file {p} ({e.strerror or e})") from None
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "?"
+            raise MapFileError(f"{path} is being updated by another process (pid {holder}, lock {p}); wait for it "
+                               "to finish") from None
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, str(os.getpid()).encode(), 0)
+        yield
+    finally:
+        os.close(fd)  # releases the flock

@@ -45,6 +45,9 @@ class CapNavMap:
     meta: dict[str, Any] = field(default_factory=dict)
     caches: dict[str, dict[str, Any]] = field(default_factory=dict)
     trajectory: CameraTrajectory | None = None  # None in maps written before it was recorded
+    # Objects whose place a later recording observed empty (``capnav map --update``): kept with when
+    # they were last seen, never returned as present; ``objects`` holds only present ones.
+    retired: list[MapObject] = field(default_factory=list)
 
     def object(self, object_id: int) -> MapObject:
         for o in self.objects:

@@ -8,6 +8,7 @@ Add fields freely; do not rename or remove them without updating every stage.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -63,6 +64,11 @@ class MapObject:
     embedding_model: str | None = None
     category_id: int = 0  # vocabulary id of ``label`` (0 = outside the vocabulary)
     track_ids: list[int] = field(default_factory=list)  # SG3DTracker tracks fused into this object
+    # Over several recordings (``capnav map --update``): where and when it was last seen
+    # ({"recording", "frame", "timestamp"}; None = in the map's only recording, at ``last_frame``)
+    # and its changes ({"recording", "event": born | moved | retired, "position", ...}), oldest first.
+    last_seen: dict[str, Any] | None = None
+    history: list[dict[str, Any]] = field(default_factory=list)
 
     @property
     def size(self) -> NDArray[np.float64]:
