@@ -1,12 +1,15 @@
 """The README's main job, end to end on a small apartment at low resolution."""
 
+import io
 from pathlib import Path
 
 import pytest
+from rich.console import Console
 from typer.testing import CliRunner
 
 from capnav.cli import app
 from capnav.core.errors import InputError
+from capnav.demo.report import verdict
 from capnav.demo.run import DemoConfig, run_demo
 
 
@@ -33,11 +36,22 @@ def test_demo_runs_the_whole_loop(tmp_path: Path) -> None:
     assert "T-numbers are truth ids, not map ids" in html and "images/apartment.png" in html
 
 
-def test_demo_user_instruction_that_matches_nothing(tmp_path: Path) -> None:
+def test_demo_user_instruction_that_matches_nothing_or_is_rejected(tmp_path: Path) -> None:
+    pasted = "go to the chair " * 7000  # 112 KB pasted by mistake
+    con = Console(record=True, width=100, file=io.StringIO())
     res = run_demo(DemoConfig(seed=3, out=tmp_path, width=160, height=120, max_frames=60,
-                              instructions=("go to the spaceship", "")))
-    assert not res.items[0].found and "spaceship" in res.items[0].reason
-    assert not res.items[1].found and res.items[1].reason.startswith("rejected")
+                              instructions=("go to the spaceship", "", pasted)), console=con)
+    assert not res.items[0].found and "spaceship" in res.items[0].reason and not res.items[0].rejected
+    assert verdict(res.items[0]) == "not found"
+    for it in res.items[1:]:  # refused instructions say so, in the console and the report, not "not found"
+        assert it.rejected and not it.found and verdict(it).startswith("rejected: ")
+    assert "too long" in res.items[2].reason
+    printed = con.export_text()
+    assert printed.count("rejected: ") == 2 and "not found" in printed
+    assert len(printed) < 5000, "the console echoed the pasted instruction"
+    assert "(112,000 characters)" in printed
+    html = res.report_html.read_text()
+    assert "rejected: " in html and len(html) < 60_000
 
 
 def test_demo_bad_arguments() -> None:

@@ -250,7 +250,7 @@ def test_cli(tmp_path: Path, frames: list[Frame]) -> None:
 def test_missing_library_says_how_to_install(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     (tmp_path / "x.bag").write_bytes(b"")
     monkeypatch.setitem(sys.modules, "rosbags", None)
-    with pytest.raises(InputError, match=r"pip install 'capnav\[ros\]'"):
+    with pytest.raises(InputError, match=r"python3? -m pip install .*\[ros\]'"):
         RosbagReader(tmp_path / "x.bag", "/a", "/b", "/c", "/d")
 
 

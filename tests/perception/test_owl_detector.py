@@ -415,7 +415,7 @@ def test_refusals(models: dict[str, Path], tmp_path: Path, monkeypatch: pytest.M
         with pytest.raises(InputError, match=next(iter(bad))):
             create_detector("owl", model_path=str(models["owlvit"]), **bad)
     monkeypatch.setitem(sys.modules, "transformers", None)  # the runtime install: no extras
-    with pytest.raises(InputError, match=r"pip install 'capnav\[detect\]'"):
+    with pytest.raises(InputError, match=r"python3? -m pip install .*\[detect\]'"):
         create_detector("owl", model_path=str(models["owlvit"]))
 
 

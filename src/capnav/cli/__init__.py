@@ -86,11 +86,12 @@ _load_commands()
 
 
 def _fail(kind: str, message: str, code: int) -> None:
-    from rich.console import Console
     from rich.markup import escape
 
+    from capnav.core.console import make_console
+
     colour = "yellow" if code == 130 else "red"
-    Console(stderr=True, soft_wrap=True).print(f"[bold {colour}]{kind}:[/] {escape(message)}", highlight=False)
+    make_console(stderr=True).print(f"[bold {colour}]{kind}:[/] {escape(message)}", highlight=False)
     sys.exit(code)
 
 

@@ -17,13 +17,12 @@ def register(app: typer.Typer) -> None:
         """Run `apt-get download sweethome3d-furniture` + `dpkg-deb -x`, keep CapNav's categories, split
         multi-material OBJ files per material, and record each model's size, creator and licence."""
 
-        from rich.console import Console
-
+        from capnav.core.console import make_console
         from capnav.sim.sh3d import fetch_assets, load_catalog
 
         out = fetch_assets(dir, deb=deb, catalogs=catalog or None)
         models = load_catalog(out.parent)
         licences = sorted({m.license for m in models})
         cats = sorted({m.category for m in models})
-        Console().print(f"{len(models)} models in {len(cats)} categories written to {out} "
+        make_console().print(f"{len(models)} models in {len(cats)} categories written to {out} "
                         f"(licences: {', '.join(licences)}); use: capnav sim --furniture sh3d", markup=False)

@@ -32,8 +32,7 @@ def register(app: typer.Typer) -> None:
         progress: bool = typer.Option(True, help="show progress bars"),
     ) -> None:
         """Fill captions and embeddings (paper 3.3); the caption cache makes reruns free."""
-        from rich.console import Console
-
+        from capnav.core.console import make_console
         from capnav.io.mapfile import load_map, save_map
         from capnav.language import create_captioner, create_embedder, describe_map
         from capnav.language.embedder import EMBEDDERS
@@ -65,7 +64,7 @@ def register(app: typer.Typer) -> None:
                      "captioner caches them")
         rep = describe_map(cmap, reader, cap, emb, progress=progress, reselect_views=reselect_views)
         save_map(cmap, out)
-        con = Console(stderr=True)
+        con = make_console(stderr=True)
         con.print(f"{out}: {rep.objects} objects, {rep.captions_new} new captions, {rep.captions_cached} cached, "
                   f"{len(rep.fallbacks)} fallbacks; captioner {cap.model_id}, embedder {emb.model_id} "
                   f"({', '.join(f'{k} {v:.1f} s' for k, v in rep.seconds.items())})", highlight=False)

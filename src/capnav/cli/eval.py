@@ -54,8 +54,7 @@ def register(app: typer.Typer) -> None:
                  "instruction, robot, kind, accept_ids) instead of generated episodes")] = None,
     ) -> None:
         """Run every method on the same apartments, maps and episodes; write results.json and report.md."""
-        from rich.console import Console
-
+        from capnav.core.console import make_console
         from capnav.eval.benchmark import run_benchmark
         from capnav.eval.episodes import parse_protocols
         from capnav.eval.method import load_methods
@@ -102,7 +101,7 @@ def register(app: typer.Typer) -> None:
                      "again to resume from them)")
         res = run_benchmark(cfg, out, workers=workers, ray_address=ray, episodes_dir=episodes, progress=progress,
                             command=" ".join(["capnav", *map(shlex.quote, sys.argv[1:])]), episode_sets=sets)
-        con = Console()
+        con = make_console()
         for s in res.summaries:
             con.print(summary_line(s))
         con.print(f"{len(res.records)} subgoals in {res.seconds:.0f} s; report: {res.out / 'report.md'}")

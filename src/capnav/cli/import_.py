@@ -37,16 +37,15 @@ def _import(reader: Callable[[], Recording], out: Path, up: str, stride: int, ma
             overwrite: bool, progress: bool, said: Callable[[Recording], str] | None = None) -> None:
     """Check ``--up`` before opening the recording, import it, print what was kept and skipped
     (``said``: a first line about the recording, e.g. which layout was recognised)."""
-    from rich.console import Console
-
     from capnav.cli.options import check_output_dir, on_interrupt
+    from capnav.core.console import make_console
     from capnav.io.align import parse_up
     from capnav.io.importer import import_recording
 
     check_output_dir(out, "--out", must_be_empty=True, overwrite=overwrite)
     parse_up(up)
     on_interrupt(f"{out} was left as it was (the dataset is built beside it and swapped in only when complete)")
-    con = Console(stderr=True, soft_wrap=True)
+    con = make_console(stderr=True)
     rec = reader()
     if said is not None:
         con.print(said(rec), highlight=False, markup=False)

@@ -67,8 +67,7 @@ def register(app: typer.Typer) -> None:
                                                             "the depth (Open3D); --no-icp only checks it"),
     ) -> None:
         """Detect, fuse the semantic voxel map, track objects and write the map file."""
-        from rich.console import Console
-
+        from capnav.core.console import make_console
         from capnav.core.errors import InputError
         from capnav.io.dataset import DatasetReader
         from capnav.io.mapfile import save_map
@@ -96,7 +95,7 @@ def register(app: typer.Typer) -> None:
         cmap = map_dataset(reader, det, enc, cfg, max_frames=max_frames, progress=progress)
         seconds = time.perf_counter() - t0
         save_map(cmap, output)
-        con = Console(stderr=True)
+        con = make_console(stderr=True)
         m = cmap.meta
         speed = f" ({m['frames_used'] / seconds:.1f} frames/s)" if seconds > 0 and m["frames_used"] else ""
         con.print(f"{output}: {len(cmap.objects)} objects, {len(cmap.voxels)} voxels, "

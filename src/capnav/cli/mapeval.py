@@ -18,11 +18,11 @@ def register(app: typer.Typer) -> None:
         json_out: Path | None = typer.Option(None, "--json", help="also write the figures as JSON"),
     ) -> None:
         """Print instance precision/recall, duplicates, category accuracy, centroid error, occupancy IoU."""
-        from rich.console import Console
         from rich.table import Table
 
         from capnav.cli.options import check_map_scene, check_output_file
         from capnav.core.atomic import write_json
+        from capnav.core.console import make_console
         from capnav.eval.map_quality import evaluate_map, truth_for_dataset
         from capnav.io.mapfile import load_map
         from capnav.sim.manifest import SceneManifest
@@ -51,7 +51,7 @@ def register(app: typer.Typer) -> None:
             table.add_column(col)
         for row in q.rows():
             table.add_row(*row)
-        con = Console()
+        con = make_console()
         con.print(table)
         if note:
             con.print(note, highlight=False)

@@ -21,21 +21,20 @@ def register(app: typer.Typer) -> None:
         dir: Path | None = typer.Option(None, "--dir", help=root_help),
     ) -> None:
         """Copy or download a model's files, check each sha256 against the pinned value, record licence and source."""
-        from rich.console import Console
-
+        from capnav.core.console import make_console
         from capnav.perception.model_store import install, spec
 
         out = install(name, root=dir, source_dir=source)
-        Console().print(f"{name} installed in {out} (licence: {spec(name).licence})", markup=False, highlight=False)
+        make_console().print(f"{name} installed in {out} (licence: {spec(name).licence})", markup=False,
+                             highlight=False)
 
     @models.command("list")
     def list_cmd(dir: Path | None = typer.Option(None, "--dir", help=root_help)) -> None:
         """Known models, where they go and whether their installed files check out."""
-        from rich.console import Console
-
+        from capnav.core.console import make_console
         from capnav.perception.model_store import installed
 
-        con = Console()
+        con = make_console()
         for row in installed(dir):
             con.print(f"{row['name']:<28} {row['status']:<14} {row['folder']}\n    {row['description']}; "
                       f"licence: {row['licence']}", markup=False, highlight=False)

@@ -46,9 +46,8 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Go to the object an instruction describes: a goal pose (x, y, yaw facing it) and an A* path in
         the map's frame (JSON, PNG, ROS map_server PGM + YAML), driven in the simulator for sim maps."""
-        from rich.console import Console
-
         from capnav.cli.options import check_map_scene, check_model_folder, check_output_dir, check_verifier
+        from capnav.core.console import make_console
         from capnav.core.errors import InputError
         from capnav.eval.drive import OCCUPANCY_KINDS, episode_start, parse_pose
         from capnav.io.mapfile import load_map
@@ -81,7 +80,7 @@ def register(app: typer.Typer) -> None:
         emb = create_embedder(embedder, **({"path": str(embedder_path)} if embedder_path else {}))
         ver_kw = {"embedder": emb} if verifier == "offline" else {}
         retriever = Retriever(cmap, emb, create_verifier(verifier, **ver_kw))
-        con = Console(stderr=True)
+        con = make_console(stderr=True)
         if drive is False or scene_seed is None:
             _plan_only(con, cmap, retriever, instruction, given, out, map_file)
             return

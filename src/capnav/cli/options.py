@@ -10,15 +10,41 @@ unwritable output is found in a second, not after minutes of mapping.
 from __future__ import annotations
 
 import errno
+import math
 import os
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from capnav.core.errors import OutputError
-from capnav.core.limits import IMAGE_MAX, IMAGE_MIN
+from capnav.core.limits import HFOV_MAX, HFOV_MIN, IMAGE_MAX, IMAGE_MIN
+
+
+def finite_float(lo: float | None = None, hi: float | None = None) -> Callable[[object], float]:
+    """A parser for a float option that names what is wrong: "nan" is not a number (a range check
+    alone would call NaN "too large", since every comparison with it is false), "inf" is not finite."""
+
+    def parse(value: object) -> float:
+        try:
+            x = float(value)  # type: ignore[arg-type]
+        except (TypeError, ValueError):
+            raise typer.BadParameter(f"{value!r} is not a number") from None
+        if math.isnan(x):
+            raise typer.BadParameter(f"{value!r} is not a number")
+        if math.isinf(x):
+            raise typer.BadParameter(f"{value!r} is not a finite number")
+        if (lo is not None and x < lo) or (hi is not None and x > hi):
+            span = f"between {lo:g} and {hi:g}" if lo is not None and hi is not None else (
+                f">= {lo:g}" if lo is not None else f"<= {hi:g}")
+            raise typer.BadParameter(f"{x:g} is out of range; give a number {span}")
+        return x
+
+    parse.__name__ = "float"  # what --help shows as the option's type
+    return parse
+
 
 # --- option types (the limits live here and in capnav.core.limits, nowhere else) -------------------
 Seed = Annotated[int, typer.Option(min=0, help="seed (a whole number >= 0; same seed = same result)")]
@@ -26,6 +52,8 @@ Width = Annotated[int, typer.Option(min=IMAGE_MIN, max=IMAGE_MAX, help="camera w
 Height = Annotated[int, typer.Option(min=IMAGE_MIN, max=IMAGE_MAX, help="camera height (pixels)")]
 MaxFrames = Annotated[int | None, typer.Option(min=1, help="use at most this many frames (>= 1; default: all)")]
 Stride = Annotated[int, typer.Option(min=1, help="keep every k-th frame (>= 1)")]
+Hfov = Annotated[float, typer.Option("--hfov", parser=finite_float(HFOV_MIN, HFOV_MAX),
+                                     help=f"horizontal field of view (degrees, {HFOV_MIN:g}..{HFOV_MAX:g})")]
 
 # --- the note Ctrl-C prints ----------------------------------------------------------------------------
 _DEFAULT_KEPT = "nothing half-written was left behind (CapNav writes every file atomically)"

@@ -86,13 +86,13 @@ def register(app: typer.Typer) -> None:
 
 
 def _print(res: object) -> None:
-    from rich.console import Console
     from rich.table import Table
 
+    from capnav.core.console import make_console
     from capnav.retrieval.result import QueryResult
 
     assert isinstance(res, QueryResult)
-    con = Console()
+    con = make_console()
     if res.chosen is None:
         con.print(f"[bold red]not found[/]: {res.instruction!r}", highlight=False)
     else:

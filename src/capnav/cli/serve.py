@@ -55,8 +55,7 @@ def register(app: typer.Typer) -> None:
         import logging
         import threading
 
-        from rich.console import Console
-
+        from capnav.core.console import make_console
         from capnav.core.errors import InputError
 
         try:
@@ -68,7 +67,7 @@ def register(app: typer.Typer) -> None:
         except ImportError as e:
             raise InputError(f"capnav serve needs the serve extra: {sys.executable} -m pip install "
                              f"'capnav[serve]' ({e})") from None
-        con = Console(stderr=True)
+        con = make_console(stderr=True)
         token = token or os.environ.get(TOKEN_ENV) or None
         if not is_loopback(host) and token is None:
             raise InputError(f"--host {host} is not loopback: anyone who can reach it could read the maps; pass "

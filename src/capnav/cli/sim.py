@@ -6,8 +6,7 @@ from pathlib import Path
 
 import typer
 
-from capnav.cli.options import Height, MaxFrames, Seed, Stride, Width, check_output_dir, on_interrupt
-from capnav.core.limits import HFOV_MAX, HFOV_MIN
+from capnav.cli.options import Height, Hfov, MaxFrames, Seed, Stride, Width, check_output_dir, on_interrupt
 
 
 def register(app: typer.Typer) -> None:
@@ -19,8 +18,7 @@ def register(app: typer.Typer) -> None:
         stride: Stride = 1,
         width: Width = 320,
         height: Height = 240,
-        hfov: float = typer.Option(90.0, "--hfov", min=HFOV_MIN, max=HFOV_MAX,
-                                   help="horizontal field of view (degrees)"),
+        hfov: Hfov = 90.0,
         rooms: int | None = typer.Option(None, "--rooms", min=3, max=7,
                                          help="number of rooms 3..7 (default: from the seed)"),
         furniture: str = typer.Option("primitives", "--furniture", help="primitives | sh3d (after `capnav assets`)"),
@@ -43,8 +41,7 @@ def register(app: typer.Typer) -> None:
                                                                   "until the new one is complete)"),
     ) -> None:
         """Write a posed RGB-D dataset (with manifest.json and topdown.png) for one apartment."""
-        from rich.console import Console
-
+        from capnav.core.console import make_console
         from capnav.core.errors import InputError
         from capnav.sim.changes import ChangeSpec
 
@@ -68,4 +65,4 @@ def register(app: typer.Typer) -> None:
                                  overwrite=overwrite, assets_dir=assets_dir, surface_items=surface_items,
                                  visit=visit, changes=spec,
                                  change_seed=change_seed, frame_offset=offset)
-        Console().print(summary, markup=False, highlight=False)
+        make_console().print(summary, markup=False, highlight=False)

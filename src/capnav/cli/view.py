@@ -29,15 +29,14 @@ def register(app: typer.Typer) -> None:
                          ] = None,
     ) -> None:
         """Log the voxel map, object boxes with ids and captions, the camera path and answers to rerun."""
-        from rich.console import Console
-
         from capnav.api import CapNav
         from capnav.cli.query import parse_xy
+        from capnav.core.console import make_console
         from capnav.viz.rerun_log import write_rrd
 
         xy = parse_xy(robot)
         nav = CapNav.open(map_path)
-        con = Console(stderr=True)
+        con = make_console(stderr=True)
         if xy is None and query and nav.map.trajectory is not None and len(nav.map.trajectory):
             (x, y, _), source = nav.start_pose()
             xy = (x, y)

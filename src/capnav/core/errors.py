@@ -50,3 +50,34 @@ class SystemIOError(CapNavError):
 
 class Interrupted(CapNavError):
     """The user pressed Ctrl-C; the message says what was interrupted and what was kept."""
+
+
+def pip_hint(requirement: str) -> str:
+    """The command that installs ``requirement`` into the Python running CapNav, for error messages.
+
+    It names this interpreter (``.venv/bin/python -m pip install ...``), not a bare ``pip``, which in a
+    new shell is the system's and refuses with "externally-managed-environment". ``capnav[EXTRA]``
+    becomes the checkout's editable install (``-e '.[EXTRA]'``) when CapNav runs from a source tree."""
+    import os
+    import shlex
+    import sys
+    from pathlib import Path
+
+    def shown(p: Path) -> str:
+        try:
+            rel = os.path.relpath(p)
+        except ValueError:  # another drive (Windows)
+            return str(p)
+        return rel if not rel.startswith("..") else str(p)
+
+    python = shown(Path(sys.executable)) if sys.executable else "python3"
+    if not python.startswith((os.sep, ".")) and os.sep in python:
+        python = f".{os.sep}{python}"
+    req = requirement
+    root = Path(__file__).resolve().parents[3]
+    if requirement.startswith("capnav[") and (root / "pyproject.toml").is_file() and (root / "src" / "capnav").is_dir():
+        where = shown(root)
+        req = f"-e {shlex.quote(where + requirement[len('capnav'):])}"
+    else:
+        req = shlex.quote(requirement)
+    return f"{shlex.quote(python) if ' ' in python else python} -m pip install {req}"

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from capnav.core.atomic import write_text
+from capnav.core.text import shorten
 
 
 @dataclass
@@ -35,6 +36,7 @@ class ReportItem:
     view_png: str | None = None  # path relative to the report folder
     map_png: str | None = None
     timings: dict[str, float] = field(default_factory=dict)
+    rejected: bool = False  # the instruction itself was refused (empty, too long, not English); ``reason`` says why
 
 
 @dataclass
@@ -53,6 +55,8 @@ TRUTH_CAPTION = ("The apartment as the simulator built it (its truth, used only 
 
 
 def verdict(it: ReportItem) -> str:
+    if it.rejected:
+        return f"rejected: {it.reason}"
     if not it.found:
         return "not found" + (" (correct)" if it.correct else " (wrong)" if it.correct is False else "")
     if it.right_object is False:
@@ -73,7 +77,7 @@ def write_markdown(report: Report, path: Path) -> None:
     if report.truth_png:
         lines += [f"![apartment]({report.truth_png})", "", TRUTH_CAPTION, ""]
     for i, it in enumerate(report.items, 1):
-        lines += [f"## {i}. \"{it.instruction}\"", "", f"*{it.kind}* — **{verdict(it)}**", ""]
+        lines += [f"## {i}. \"{shorten(it.instruction, 200)}\"", "", f"*{it.kind}* — **{verdict(it)}**", ""]
         if it.found:
             lines += [f"- chosen: object {it.chosen_id} ({it.chosen_label}), score {it.score:.3f}",
                       f"- caption: {it.caption}"]
@@ -109,7 +113,7 @@ def write_html(report: Report, path: Path) -> None:
                      f"<figcaption>{e(TRUTH_CAPTION)}</figcaption></figure>")
     for i, it in enumerate(report.items, 1):
         good = (it.correct is not False) and (it.reached is not False)
-        parts.append(f"<div class='item'><h2>{i}. &ldquo;{e(it.instruction)}&rdquo;</h2>")
+        parts.append(f"<div class='item'><h2>{i}. &ldquo;{e(shorten(it.instruction, 200))}&rdquo;</h2>")
         css = "ok" if good else "bad"
         parts.append(f"<p><i>{e(it.kind)}</i> &mdash; <b class='{css}'>{e(verdict(it))}</b></p><ul>")
         if it.found:

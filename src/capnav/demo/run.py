@@ -15,11 +15,14 @@ from typing import Any
 
 import numpy as np
 from rich.console import Console
+from rich.markup import escape
 
 from capnav.core.atomic import write_bytes, write_json
+from capnav.core.console import make_console
 from capnav.core.errors import CapNavError, InputError
 from capnav.core.grid import FREE
 from capnav.core.limits import check_count, check_image_size
+from capnav.core.text import shorten
 from capnav.demo.report import Report, ReportItem, verdict, write_html, write_markdown
 from capnav.eval.drive import run_instruction
 from capnav.eval.generate import SceneTruth
@@ -81,7 +84,7 @@ def _next_instruction(cfg: DemoConfig, k: int, sim: Any, robot_xy: tuple[float, 
 
 
 def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
-    con = console or Console(stderr=True)
+    con = console or make_console(stderr=True)
     out = cfg.out
     (out / "images").mkdir(parents=True, exist_ok=True)
     timings: dict[str, float] = {}
@@ -126,7 +129,8 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
         text, kind, targets = nxt
         it = _answer(len(items) + 1, text, kind, targets, retriever, agent, cmap, assets, truth, pcfg_plan, out)
         items.append(it)
-        con.print(f"     {len(items)}. \\[{kind}] {text!r}: {it.chosen_label or '-'}: {verdict(it)}")
+        con.print(f"     {len(items)}. \\[{kind}] {escape(repr(shorten(text)))}: {it.chosen_label or '-'}: "
+                  f"{escape(verdict(it))}")
 
     con.print("[bold]4/4[/] writing the report")
     timings["total"] = time.perf_counter() - t0
@@ -158,7 +162,7 @@ def _answer(k: int, text: str, kind: str, targets: list[int], retriever: Retriev
         res = run_instruction(cmap, assets.sim, retriever, text, agent=agent, config=plan_cfg,
                               out_dir=out / "images", stem=f"{k:02d}_nav")
     except CapNavError as e:  # e.g. an empty or non-English instruction: report it, keep going
-        return ReportItem(text, kind, False, None, None, None, None, f"rejected: {e}",
+        return ReportItem(text, kind, False, None, None, None, None, str(e), rejected=True,
                           correct=None if kind == "user" else False)
     q, nav, obj = res.query, res.nav, res.query.chosen
     item = ReportItem(text, kind, q.found, obj.id if obj else None, obj.label if obj else None,

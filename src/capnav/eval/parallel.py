@@ -12,7 +12,7 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from typing import Any, TypeVar
 
-from capnav.core.errors import InputError
+from capnav.core.errors import InputError, pip_hint
 from capnav.core.progress import track
 
 T = TypeVar("T")
@@ -89,7 +89,7 @@ def _run_ray(fn: Callable[[T], R], tasks: Sequence[T], address: str, progress: b
     try:
         import ray
     except ImportError:
-        raise InputError("--ray needs the optional dependency: pip install 'capnav[ray]'") from None
+        raise InputError(f"--ray needs the optional dependency: {pip_hint('capnav[ray]')}") from None
     if not ray.is_initialized():
         ray.init(address=None if address == "local" else address, include_dashboard=False,
                  log_to_driver=False, ignore_reinit_error=True)

@@ -224,6 +224,10 @@ def load_map(path: str | Path, voxels: bool = True) -> CapNavMap:
     with the stored resolution, origin, feature dim and projection. For readers that use only
     objects and occupancy (``capnav query``); entries not read are not checksummed."""
     p = Path(path)
+    if p.is_dir():
+        hint = ", ".join(sorted(q.name for q in p.glob("*.capnav"))[:3])
+        raise MapFileError(f"{p} is a folder, not a map file; give the .capnav file `capnav map -o` wrote"
+                           + (f" (this folder has {hint})" if hint else ""))
     if not p.is_file():
         raise MapFileError(f"map file not found: {p}")
     try:

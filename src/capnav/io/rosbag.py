@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from capnav.core.errors import InputError
+from capnav.core.errors import InputError, pip_hint
 from capnav.core.geometry import Intrinsics
 from capnav.io.assoc import PoseTrack, SkipLog, check_gap, match_nearest, poses_from_quat
 from capnav.io.importer import PlannedFrame
@@ -44,7 +44,7 @@ def _rosbags() -> Any:
     try:
         from rosbags import highlevel
     except ImportError:
-        raise InputError("reading ROS bags needs the rosbags library: pip install 'capnav[ros]'") from None
+        raise InputError(f"reading ROS bags needs the rosbags library: {pip_hint('capnav[ros]')}") from None
     return highlevel
 
 

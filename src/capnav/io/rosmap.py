@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from PIL import Image
 
 from capnav.core.atomic import atomic_path, write_text
-from capnav.core.errors import InputError
+from capnav.core.errors import InputError, pip_hint
 from capnav.core.grid import FREE, OCCUPIED, UNKNOWN, GridSpec, OccupancyGrid
 
 PIXEL = {FREE: 254, OCCUPIED: 0, UNKNOWN: 205}
@@ -56,7 +56,7 @@ def read_ros_map(yaml_path: str | Path) -> OccupancyGrid:
     try:
         import yaml
     except ImportError:
-        raise InputError("reading a map_server YAML needs PyYAML: pip install pyyaml") from None
+        raise InputError(f"reading a map_server YAML needs PyYAML: {pip_hint('pyyaml')}") from None
     yp = Path(yaml_path)
     try:
         meta: dict[str, Any] = yaml.safe_load(yp.read_text())

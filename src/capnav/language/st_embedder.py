@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from capnav.core.errors import ModelError
+from capnav.core.errors import ModelError, pip_hint
 from capnav.language.embedder import EMBEDDERS, TextEmbedder
 
 
@@ -28,7 +28,7 @@ class SentenceTransformerEmbedder(TextEmbedder):
         try:
             from sentence_transformers import SentenceTransformer
         except ImportError:
-            raise ModelError("sentence-transformers is not installed: pip install 'capnav[bge]'") from None
+            raise ModelError(f"sentence-transformers is not installed: {pip_hint('capnav[bge]')}") from None
         p = Path(path)
         if local_files_only and p.is_absolute() and not p.is_dir():
             raise ModelError(f"sentence-transformers folder not found: {p}")
@@ -65,7 +65,7 @@ class FlagEmbedder(TextEmbedder):
         try:
             from FlagEmbedding import BGEM3FlagModel
         except ImportError:
-            raise ModelError("FlagEmbedding is not installed: pip install 'capnav[flag]'") from None
+            raise ModelError(f"FlagEmbedding is not installed: {pip_hint('capnav[flag]')}") from None
         try:
             self._model = BGEM3FlagModel(str(p), use_fp16=False, devices="cpu")
         except Exception as e:

@@ -21,6 +21,7 @@ from capnav.mapping.cmap import CameraTrajectory, CapNavMap
 from capnav.mapping.frame_merge import FrameMergeConfig, merge_frame_detections
 from capnav.mapping.lifting import LiftConfig, LiftedDetection, lift_detection
 from capnav.mapping.memory import MemoryConfig, ObjectMemory
+from capnav.mapping.motion import PoseJumps, find_pose_jumps
 from capnav.mapping.objects import Observation
 from capnav.mapping.occupancy import OccupancyConfig, occupancy_from_voxels
 from capnav.mapping.tracker import SG3DTracker, TrackerConfig
@@ -40,8 +41,10 @@ class MapperConfig:
     without detections, the tracker does not see the frame (no detections is not evidence of
     absence), and the failure is counted per kind in ``meta["detector_errors"]``.
     Frames with more than ``max_invalid_depth`` invalid depth pixels count as bad. A camera that
-    moves more than ``max_pose_jump`` between consecutive used frames is listed in
-    ``meta["pose_jumps"]`` (a wrong pose convention or a dropped stretch of frames shows up there).
+    moves more than ``max_pose_jump`` and more than ``pose_jump_factor`` times the stream's usual
+    step between consecutive used frames is listed in ``meta["pose_jumps"]`` and named in one
+    warning (a dropped stretch of frames or a wrong pose convention shows up there; a stream kept
+    sparse on purpose does not: ``capnav.mapping.motion``).
     """
 
     voxel: VoxelConfig = field(default_factory=VoxelConfig)
@@ -52,7 +55,8 @@ class MapperConfig:
     frame_merge: FrameMergeConfig = field(default_factory=FrameMergeConfig)
     on_bad_frame: Literal["skip", "raise"] = "skip"
     max_invalid_depth: float = 0.98
-    max_pose_jump: float = 1.5  # m between consecutive frames; larger jumps are reported, not skipped
+    max_pose_jump: float = 1.5  # m between consecutive frames; a shorter move is never reported as a jump
+    pose_jump_factor: float = 4.0  # x the stream's usual step; longer moves are reported, not skipped
 
     def __post_init__(self) -> None:
         if self.on_bad_frame not in ("skip", "raise"):
@@ -85,8 +89,6 @@ class Mapper:
         self.detector_errors: dict[str, dict[str, Any]] = {}
         self.lift_skips = 0
         self.frame_merges = 0
-        self.pose_jumps: list[dict[str, Any]] = []
-        self._last_eye: NDArray[np.float64] | None = None
         self.camera_path: list[tuple[int, NDArray[np.float64]]] = []  # (frame index, T_wc) of every frame fused
         self.seconds = 0.0
 
@@ -144,13 +146,6 @@ class Mapper:
                 raise FrameError(frame.index, "encoder returned non-finite features")
         except FrameError as e:
             return self._bad(e)
-        eye = np.asarray(frame.T_wc, dtype=np.float64)[:3, 3]
-        if self._last_eye is not None:
-            jump = float(np.linalg.norm(eye - self._last_eye))
-            if jump > self.config.max_pose_jump:
-                log.warning("frame %s: camera moved %.2f m since the previous frame", frame.index, jump)
-                self.pose_jumps.append({"frame": frame.index, "metres": round(jump, 3)})
-        self._last_eye = eye
         self.camera_path.append((int(frame.index), np.asarray(frame.T_wc, dtype=np.float64).copy()))
         vc = self.config.voxel
         proj = self.voxels.project(table) if self.voxels.projection is not None else table
@@ -185,18 +180,27 @@ class Mapper:
         for t in step.deaths:
             self.memory.drop(t)
 
+    def pose_jumps(self) -> PoseJumps:
+        """The camera moves so far that are much longer than this stream's usual step."""
+        idx = [i for i, _ in self.camera_path]
+        eyes = [T[:3, 3] for _, T in self.camera_path]
+        return find_pose_jumps(idx, eyes, self.config.max_pose_jump, self.config.pose_jump_factor)
+
     def finish(self, meta: dict[str, Any] | None = None) -> CapNavMap:
         """Merge duplicates, export objects, derive occupancy; ``meta`` adds/overrides metadata."""
         merged = self.memory.merge_duplicates()
         objects = self.memory.export()
         occ = occupancy_from_voxels(self.voxels, self.config.occupancy)
+        jumps = self.pose_jumps()
+        if jumps.jumps:
+            log.warning(jumps.message())
         info: dict[str, Any] = {
             "frames_used": len(self.frames_used),
             "first_frame": self.frames_used[0] if self.frames_used else None,
             "last_frame": self.frames_used[-1] if self.frames_used else None,
             "frames_skipped": list(self.skipped),
             "detector_errors": list(self.detector_errors.values()),
-            "pose_jumps": list(self.pose_jumps),
+            "pose_jumps": jumps.jumps,
             "detections_without_depth": self.lift_skips,
             "tracks": self.tracker._next_id - 1,
             "merged_duplicates": merged,

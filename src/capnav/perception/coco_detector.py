@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 from PIL import Image
 
-from capnav.core.errors import FrameError, InputError, ModelError
+from capnav.core.errors import FrameError, InputError, ModelError, pip_hint
 from capnav.core.frame import Frame
 from capnav.perception.base import DETECTORS, Detection, Detector
 from capnav.perception.box_masks import depth_box_masks, filled_box_mask, floor_pixels
@@ -175,10 +175,10 @@ def _import_cv2() -> Any:
         import cv2
     except ImportError:
         raise InputError("the yolo-fastest detector needs OpenCV 4 (its Darknet reader): "
-                         "pip install 'capnav[coco]'") from None
+                         f"{pip_hint('capnav[coco]')}") from None
     if not hasattr(cv2, "dnn") or not hasattr(cv2.dnn, "readNetFromDarknet"):
         raise InputError(f"OpenCV {cv2.__version__} has no Darknet reader (OpenCV 5 dropped it): "
-                         "pip install 'opencv-python-headless<5'")
+                         f"{pip_hint('opencv-python-headless<5')}")
     return cv2
 
 

@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.core.categories import NAMES, category
-from capnav.core.errors import FrameError, InputError, ModelError
+from capnav.core.errors import FrameError, InputError, ModelError, pip_hint
 from capnav.core.frame import Frame
 from capnav.perception.base import DETECTORS, Detection, Detector
 from capnav.perception.box_masks import depth_box_masks, filled_box_mask, floor_pixels
@@ -39,7 +39,7 @@ from capnav.perception.nms import per_class_nms
 
 MASK_MODES = ("depth", "sam", "box")
 OWL_MODEL_TYPES = ("owlvit", "owlv2")
-_EXTRA_HINT = "pip install 'capnav[detect]'"
+_EXTRA_HINT = pip_hint('capnav[detect]')
 
 
 def batched_nms(boxes: NDArray[np.floating], scores: NDArray[np.floating], classes: NDArray[np.integer],

@@ -11,7 +11,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from capnav.core.errors import InputError
+from capnav.core.errors import InputError, pip_hint
 from capnav.core.registry import Registry
 from capnav.planning.search import astar
 
@@ -48,7 +48,7 @@ def _mcp_factory() -> GridSearch:
     try:
         from skimage.graph import MCP_Geometric
     except ImportError:
-        raise InputError("backend 'mcp' needs scikit-image: pip install 'capnav[bench]'") from None
+        raise InputError(f"backend 'mcp' needs scikit-image: {pip_hint('capnav[bench]')}") from None
 
     def search(weights: NDArray[np.float64], start: Cell, goal: Cell) -> tuple[NDArray[np.intp], float]:
         costs = np.where(np.isfinite(weights), weights, -1.0)  # negative = impassable for MCP
@@ -68,7 +68,7 @@ def _pyastar_factory() -> GridSearch:
     try:
         import pyastar2d
     except ImportError:
-        raise InputError("backend 'pyastar2d' needs pyastar2d: pip install 'capnav[bench]'") from None
+        raise InputError(f"backend 'pyastar2d' needs pyastar2d: {pip_hint('capnav[bench]')}") from None
 
     def search(weights: NDArray[np.float64], start: Cell, goal: Cell) -> tuple[NDArray[np.intp], float]:
         path = pyastar2d.astar_path(weights.astype(np.float32), start, goal, allow_diagonal=True)
@@ -89,7 +89,7 @@ def _tcod_factory() -> GridSearch:
     try:
         import tcod.path
     except ImportError:
-        raise InputError("backend 'tcod' needs python-tcod: pip install 'capnav[bench]'") from None
+        raise InputError(f"backend 'tcod' needs python-tcod: {pip_hint('capnav[bench]')}") from None
 
     def search(weights: NDArray[np.float64], start: Cell, goal: Cell) -> tuple[NDArray[np.intp], float]:
         cost = np.where(np.isfinite(weights), weights, 0.0).astype(np.float32)  # 0 = blocked for tcod

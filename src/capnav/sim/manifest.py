@@ -127,4 +127,15 @@ class SceneManifest(BaseModel):
         try:
             return cls.model_validate(data)
         except ValidationError as e:
-            raise DatasetError(f"manifest {p} is malformed: {e}") from None
+            raise DatasetError(f"manifest {p} is malformed: {_first_problem(e)}") from None
+
+
+def _first_problem(e: ValidationError) -> str:
+    """The first field pydantic refused, in one line ("objects[3].category is missing"), and how
+    many more there are; not pydantic's multi-line dump with its documentation link."""
+    errs = e.errors(include_url=False)
+    first = errs[0]
+    where = "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in first["loc"]).lstrip(".") or "the top level"
+    what = "is missing" if first["type"] == "missing" else f"is wrong: {first['msg']}"
+    more = f" (and {len(errs) - 1} more problem{'s' if len(errs) > 2 else ''})" if len(errs) > 1 else ""
+    return f"{where} {what}{more}"

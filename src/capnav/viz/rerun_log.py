@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from capnav.core.errors import InputError
+from capnav.core.errors import InputError, pip_hint
 from capnav.core.grid import OCCUPIED
 from capnav.mapping.cmap import CapNavMap
 
@@ -45,11 +45,11 @@ def _rerun() -> Any:
     try:
         import rerun as rr
     except ImportError as e:
-        raise InputError(f"3D views need the viz extra: pip install 'capnav[viz]' ({e})") from None
+        raise InputError(f"3D views need the viz extra: {pip_hint('capnav[viz]')} ({e})") from None
     have = tuple(int(v) for v in rr.__version__.split(".")[:2])
     if have != RERUN_MINOR:
         raise InputError(f"capnav's 3D views are written for rerun-sdk {RERUN_MINOR[0]}.{RERUN_MINOR[1]}.x, found "
-                         f"{rr.__version__}: pip install 'capnav[viz]'")
+                         f"{rr.__version__}: {pip_hint('capnav[viz]')}")
     return rr
 
 

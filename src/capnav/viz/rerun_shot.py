@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from capnav.core.errors import CapNavError, InputError
+from capnav.core.errors import CapNavError, InputError, pip_hint
 from capnav.viz.rerun_log import _rerun
 
 _ANSI = re.compile(r"\x1b\[[0-9;]*m")
@@ -55,7 +55,7 @@ def rerun_executable() -> Path:
     here = Path(sys.executable).parent / "rerun"
     found = here if here.exists() else shutil.which("rerun")
     if found is None:
-        raise InputError("no rerun viewer binary found beside Python or on PATH: pip install 'capnav[viz]'")
+        raise InputError(f"no rerun viewer binary found beside Python or on PATH: {pip_hint('capnav[viz]')}")
     return Path(found)
 
 

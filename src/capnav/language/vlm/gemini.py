@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 from typing import Any
 
-from capnav.core.errors import ModelError
+from capnav.core.errors import ModelError, pip_hint
 from capnav.language.vlm.base import VLMS, RateLimited
 
 DEFAULT_MODEL = "gemini-2.5-flash-lite"
@@ -32,7 +32,7 @@ class GeminiVLM:
             from google import genai
             from google.genai import types
         except ImportError:
-            raise ModelError("google-genai is not installed: pip install 'capnav[gemini]'") from None
+            raise ModelError(f"google-genai is not installed: {pip_hint('capnav[gemini]')}") from None
         self._types = types
         opts: dict[str, Any] = {"timeout": int(timeout * 1000)}
         if base_url:

@@ -12,7 +12,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from capnav.core.errors import ModelError
+from capnav.core.errors import ModelError, pip_hint
 from capnav.language.vlm.base import VLMS
 
 
@@ -25,7 +25,7 @@ class HFLocalVLM:
         try:
             from transformers import AutoModelForImageTextToText, AutoProcessor
         except ImportError:
-            raise ModelError("transformers is not installed: pip install 'capnav[vlm]'") from None
+            raise ModelError(f"transformers is not installed: {pip_hint('capnav[vlm]')}") from None
         try:
             self._proc = AutoProcessor.from_pretrained(str(p), local_files_only=True)
             model: Any = AutoModelForImageTextToText.from_pretrained(str(p), local_files_only=True)

@@ -11,7 +11,7 @@ import base64
 import os
 from typing import Any
 
-from capnav.core.errors import ModelError
+from capnav.core.errors import ModelError, pip_hint
 from capnav.language.vlm.base import VLMS, RateLimited
 
 
@@ -21,7 +21,7 @@ class OpenAICompatVLM:
         try:
             import httpx
         except ImportError:
-            raise ModelError("httpx is not installed: pip install 'capnav[openai]'") from None
+            raise ModelError(f"httpx is not installed: {pip_hint('capnav[openai]')}") from None
         self.base_url = (base_url or os.environ.get("OPENAI_BASE_URL") or "https://api.openai.com/v1").rstrip("/")
         headers = {"Content-Type": "application/json"}
         key = os.environ.get(api_key_env)
