@@ -324,8 +324,9 @@ class CapNav:
     def costmap(self) -> Costmap:
         if self._costmap is None:
             from capnav.planning.costmap import build_costmap
+            from capnav.planning.sight import map_columns
 
-            self._costmap = build_costmap(self.occupancy, self.planner_config)
+            self._costmap = build_costmap(self.occupancy, self.planner_config, map_columns(self.map))
         return self._costmap
 
     def start_pose(self) -> tuple[tuple[float, float, float], str]:
@@ -359,9 +360,11 @@ class CapNav:
     def _goal(self, obj: MapObject, xy: tuple[float, float]) -> tuple[GoalPose | None, str]:
         """The goal pose, or None and why (the answer stands even when the robot cannot plan)."""
         from capnav.planning.goal import select_goal
+        from capnav.planning.sight import object_heights
 
         try:
-            return select_goal(self.occupancy, obj.footprint, xy, self.planner_config, self.costmap), ""
+            return select_goal(self.occupancy, obj.footprint, xy, self.planner_config, self.costmap,
+                               z_range=object_heights(obj)), ""
         except (NotFoundError, InputError) as e:
             return None, f"no goal pose: {e}"
 
@@ -388,7 +391,10 @@ class CapNav:
         try:
             goal = target.goal if isinstance(target, Answer) and target.robot == xy else None
             if goal is None:  # an answer asked from this start already holds its goal: one search less
-                goal = select_goal(self.occupancy, obj.footprint, xy, self.planner_config, self.costmap)
+                from capnav.planning.sight import object_heights
+
+                goal = select_goal(self.occupancy, obj.footprint, xy, self.planner_config, self.costmap,
+                                   z_range=object_heights(obj))
             path = plan_path(self.occupancy, xy, goal.xy, self.planner_config, self.costmap)
         except NotFoundError as e:
             return Plan(False, np.array([[*xy, yaw0]]), 0.0, str(e), None, oid)

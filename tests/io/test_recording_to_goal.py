@@ -87,7 +87,13 @@ def test_recording_to_goal_pose(walk, shared_dir: Path, tmp_path: Path) -> None:
     p = np.linalg.solve(M, np.r_[obj.position, 1.0])[:3]
     assert min(float(np.linalg.norm(p[:2] - s[:2])) for s in stools) < 0.5
 
+    # The camera never saw part of the floor on the way: the plan says so (not ok) unless that is accepted.
     r = cli.invoke(app, ["navigate", str(run / "described.capnav"), "go to the chair", "--out", str(run)])
+    assert r.exit_code == 1 and "of unknown space" in r.output
+    rec = json.loads((run / "navigate.json").read_text())
+    assert rec["ok"] is False and rec["goal"]["ok"] and rec["path"]["seen_free_fraction"] < 1
+    r = cli.invoke(app, ["navigate", str(run / "described.capnav"), "go to the chair", "--out", str(run),
+                         "--through-unknown"])
     assert r.exit_code == 0, r.output
     rec = json.loads((run / "navigate.json").read_text())
     assert rec["frame"] == "map" and rec["ok"] and rec["retrieval"]["chosen"]["label"] == "chair"

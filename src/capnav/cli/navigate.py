@@ -43,6 +43,9 @@ def register(app: typer.Typer) -> None:
                                  ] = None,
         verifier: Annotated[str, typer.Option(help="verification backend: offline, none, gemini, openai, ...")
                             ] = "offline",
+        through_unknown: Annotated[bool, typer.Option(
+            "--through-unknown", help="accept a planned path that crosses unknown space (default: such a plan is "
+                                      "reported as not ok)")] = False,
     ) -> None:
         """Go to the object an instruction describes: a goal pose (x, y, yaw facing it) and an A* path in
         the map's frame (JSON, PNG, ROS map_server PGM + YAML), driven in the simulator for sim maps."""
@@ -82,7 +85,7 @@ def register(app: typer.Typer) -> None:
         retriever = Retriever(cmap, emb, create_verifier(verifier, **ver_kw))
         con = make_console(stderr=True)
         if drive is False or scene_seed is None:
-            _plan_only(con, cmap, retriever, instruction, given, out, map_file)
+            _plan_only(con, cmap, retriever, instruction, given, out, map_file, through_unknown)
             return
         from capnav.eval.drive import random_start, run_instruction
         from capnav.io.rosmap import write_ros_map
@@ -105,11 +108,12 @@ def register(app: typer.Typer) -> None:
 
 
 def _plan_only(con: Console, cmap: CapNavMap, retriever: Retriever, instruction: str,
-               start: tuple[float, float, float] | None, out: Path, map_file: Path) -> None:
+               start: tuple[float, float, float] | None, out: Path, map_file: Path, through_unknown: bool = False
+               ) -> None:
     """No simulator: the goal pose and path on the map, written for a robot stack; exit 1 when there is none."""
     from capnav.planning.on_map import navigate_on_map, write_outputs
 
-    nav = navigate_on_map(cmap, retriever, instruction, start)
+    nav = navigate_on_map(cmap, retriever, instruction, start, through_unknown=through_unknown)
     q = nav.query
     con.print(f"start: ({nav.start[0]:.2f}, {nav.start[1]:.2f}, yaw {nav.start[2]:.2f}) from {nav.start_source}",
               highlight=False)

@@ -18,6 +18,7 @@ from capnav.core.errors import InputError
 from capnav.core.grid import OccupancyGrid
 from capnav.planning.config import PlannerConfig
 from capnav.planning.execute import NavResult, navigate_to
+from capnav.planning.sight import map_columns, object_heights
 
 if TYPE_CHECKING:
     from capnav.mapping.cmap import CapNavMap
@@ -112,7 +113,8 @@ def run_instruction(cmap: CapNavMap, sim: Simulator, retriever: Retriever, instr
     query = retriever.query(instruction, robot_xy=(start[0], start[1]))
     nav = None
     if query.found and query.chosen is not None:
-        nav = navigate_to(agent, occ, query.chosen.footprint, cfg)
+        nav = navigate_to(agent, occ, query.chosen.footprint, cfg, z_range=object_heights(query.chosen),
+                          columns=map_columns(cmap))
     out = InstructionOutcome(instruction, query, nav, start, occupancy)
     if out_dir is not None:
         from capnav.viz.topdown import short_label, write_navigation

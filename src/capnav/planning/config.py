@@ -13,7 +13,8 @@ class PlannerConfig:
 
     ``reach`` is the paper's 1 m success radius around the goal instance. Goal selection aims a
     little inside it (``goal_margin``) so a slightly wrong mapped footprint still counts as reached,
-    and (``prefer_line_of_sight``) at a cell that sees the object when one within reach does.
+    and (``prefer_line_of_sight``, the goal rule of planning/goal.py) at a cell of seen free floor in
+    the object's room that sees it from ``eye_height`` when one within reach does.
     """
 
     robot_radius: float = 0.2  # m, the agent's base radius (the simulator agent's default)
@@ -23,6 +24,8 @@ class PlannerConfig:
     # Among cells within reach, prefer those that see the object on the map (planning/sight.py);
     # False keeps the paper's rule: the nearest cell within reach, wall or no wall.
     prefer_line_of_sight: bool = True
+    # The robot's eye (camera) above the floor, for 3D lines of sight (the simulator agent's camera).
+    eye_height: float = 1.25
     # Weight of an unknown cell (None = blocked). 5 from a sweep with benchmarks/eval_reach.py on sparse
     # (20-frame, noisy-depth) maps: blocked 82.8%, 1.5 98.1%, 3 98.9%, 5 100%, 10 100% reached.
     unknown_cost: float | None = 5.0
@@ -39,7 +42,7 @@ class PlannerConfig:
 
     def __post_init__(self) -> None:
         for name in ("robot_radius", "safety_margin", "goal_margin", "escape_radius", "blocked_mark_radius",
-                     "clearance_band", "clearance_cost", "probe_step"):
+                     "clearance_band", "clearance_cost", "probe_step", "eye_height"):
             v = getattr(self, name)
             if not v >= 0.0:
                 raise InputError(f"PlannerConfig.{name} must be >= 0, got {v}")

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -11,6 +12,9 @@ from scipy import ndimage
 from capnav.core.errors import InputError, NotFoundError
 from capnav.core.grid import FREE, OCCUPIED, UNKNOWN, GridSpec, OccupancyGrid
 from capnav.planning.config import PlannerConfig
+
+if TYPE_CHECKING:
+    from capnav.planning.sight import HeightColumns
 
 Cell = tuple[int, int]
 
@@ -22,6 +26,8 @@ class Costmap:
 
     occ: OccupancyGrid  # the grid as given (not inflated)
     weights: NDArray[np.float64]
+    columns: HeightColumns | None = None  # observed heights per cell, for 3D lines of sight (planning/sight.py)
+    cache: dict[str, Any] = field(default_factory=dict, repr=False)  # per-map results (room regions)
 
     @property
     def spec(self) -> GridSpec:
@@ -46,8 +52,10 @@ def check_occupancy(occ: object) -> OccupancyGrid:
     return occ
 
 
-def build_costmap(occ: OccupancyGrid, config: PlannerConfig | None = None) -> Costmap:
-    """Inflate obstacles, add the clearance cost near them and price unknown space."""
+def build_costmap(occ: OccupancyGrid, config: PlannerConfig | None = None,
+                  columns: HeightColumns | None = None) -> Costmap:
+    """Inflate obstacles, add the clearance cost near them and price unknown space; ``columns``
+    (the map's observed heights) ride along for goal selection's lines of sight."""
     cfg = config or PlannerConfig()
     occ = check_occupancy(occ)
     obstacle = occ.cells == OCCUPIED
@@ -60,7 +68,7 @@ def build_costmap(occ: OccupancyGrid, config: PlannerConfig | None = None) -> Co
     unknown = occ.cells == UNKNOWN
     w[unknown] = np.inf if cfg.unknown_cost is None else np.maximum(w[unknown], cfg.unknown_cost)
     w[obstacle] = np.inf
-    return Costmap(OccupancyGrid(occ.spec, occ.cells.copy()), w)
+    return Costmap(OccupancyGrid(occ.spec, occ.cells.copy()), w, columns)
 
 
 def mark_blocked(costmap: Costmap, xy: NDArray[np.floating], radius: float, config: PlannerConfig,

@@ -22,6 +22,7 @@ from capnav.planning.config import PlannerConfig
 from capnav.planning.costmap import Costmap, build_costmap, mark_blocked
 from capnav.planning.goal import GoalPose, check_footprint, select_goal
 from capnav.planning.path import PlannedPath, plan_path
+from capnav.planning.sight import HeightColumns
 
 
 @runtime_checkable
@@ -68,8 +69,10 @@ class NavResult:
 
 
 def navigate_to(agent: StepAgent, occ: OccupancyGrid, target_footprint: NDArray[np.floating],
-                config: PlannerConfig | None = None, costmap: Costmap | None = None) -> NavResult:
-    """Select a goal near ``target_footprint``, plan with A*, and drive ``agent`` there.
+                config: PlannerConfig | None = None, costmap: Costmap | None = None, *,
+                z_range: tuple[float, float] | None = None, columns: HeightColumns | None = None) -> NavResult:
+    """Select a goal near ``target_footprint`` (heights ``z_range``, seen through ``columns`` or the
+    costmap's), plan with A*, and drive ``agent`` there.
 
     Bad input (map, footprint, a start inside an obstacle) raises; failing to get there (goal
     unreachable, too many collisions) returns ``reached=False`` with the reason.
@@ -82,8 +85,9 @@ def navigate_to(agent: StepAgent, occ: OccupancyGrid, target_footprint: NDArray[
         # Planning for a thinner robot than the one driving would graze every wall.
         cfg = replace(cfg, robot_radius=radius)
         events.append(f"robot_radius raised to the agent's {radius:.2f} m")
+        columns = columns if columns is not None else (costmap.columns if costmap is not None else None)
         costmap = None
-    levels = _Levels(occ, cfg, costmap)
+    levels = _Levels(occ, cfg, costmap, columns, z_range)
     log = _Log(agent, cfg.max_steps)
     goal: GoalPose | None = None
     plans: list[PlannedPath] = []
@@ -137,7 +141,9 @@ class _Levels:
     still fit the robot: the grid is coarser than the geometry). Contacts will tell if not.
     """
 
-    def __init__(self, occ: OccupancyGrid, cfg: PlannerConfig, costmap: Costmap | None) -> None:
+    def __init__(self, occ: OccupancyGrid, cfg: PlannerConfig, costmap: Costmap | None,
+                 columns: HeightColumns | None = None, z_range: tuple[float, float] | None = None) -> None:
+        self.z_range = z_range
         self.cfgs = [cfg]
         if cfg.relax:
             half = 0.5 * occ.spec.resolution
@@ -145,13 +151,17 @@ class _Levels:
                 self.cfgs.append(replace(cfg, safety_margin=0.0))
             if cfg.robot_radius > half:
                 self.cfgs.append(replace(cfg, safety_margin=0.0, robot_radius=cfg.robot_radius - half))
-        base = build_costmap(occ, cfg) if costmap is None else costmap
-        # Private copies: contact marks must not leak into the caller's map.
-        self.maps = {0: Costmap(OccupancyGrid(base.spec, base.occ.cells.copy()), base.weights.copy())}
+        base = build_costmap(occ, cfg, columns) if costmap is None else costmap
+        self.columns = columns if columns is not None else base.columns
+        # Private copies: contact marks must not leak into the caller's map (the room regions may
+        # be shared: a contact mark does not move a wall).
+        self.maps = {0: Costmap(OccupancyGrid(base.spec, base.occ.cells.copy()), base.weights.copy(), self.columns,
+                                dict(base.cache))}
 
     def _map(self, i: int) -> Costmap:
         if i not in self.maps:  # built lazily from level 0's grid, so it carries the marks so far
-            self.maps[i] = build_costmap(self.maps[0].occ, self.cfgs[i])
+            self.maps[i] = build_costmap(self.maps[0].occ, self.cfgs[i], self.columns)
+            self.maps[i].cache.update(self.maps[0].cache)
         return self.maps[i]
 
     def plan(self, fp: NDArray[np.float64], here: tuple[float, float]) -> tuple[GoalPose, PlannedPath, str]:
@@ -161,7 +171,7 @@ class _Levels:
         for i, cfg in enumerate(self.cfgs):
             cm = self._map(i)
             try:
-                goal = select_goal(cm.occ, fp, here, cfg, cm)
+                goal = select_goal(cm.occ, fp, here, cfg, cm, z_range=self.z_range)
                 plan = plan_path(cm.occ, here, goal.xy, cfg, cm)
             except CapNavError as e:
                 error = error or e

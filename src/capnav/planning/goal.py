@@ -1,10 +1,21 @@
-"""Goal selection (Sec. 3.4): the chosen object's footprint becomes a reachable metric waypoint.
+"""Goal selection (Sec. 3.4): where a person sent to the object would stop.
 
-The paper turns the object's cell into a waypoint; an object's own cell is an obstacle, so we pick
-the free cell nearest to the robot (by path cost) among those within the reach radius of the
-footprint, aiming ``goal_margin`` inside it when possible, and face the object from there. Within
-1 m of an object may lie behind its wall, so cells that see the object on the map come first
-(``PlannerConfig.prefer_line_of_sight``, see :mod:`capnav.planning.sight`).
+The paper turns the object's cell into a waypoint; an object's own cell is an obstacle, so a
+goal is a free cell within the reach radius of the footprint, aiming ``goal_margin`` inside it,
+facing the object. Within 1 m of an object may lie behind its wall, in the next room or on
+floor nobody saw, so among those cells the goal rule (``PlannerConfig.prefer_line_of_sight``)
+asks for one that
+
+- stands on seen free floor (a FREE cell of the map, never an UNKNOWN one),
+- lies in the free-space region (room, :func:`capnav.language.rooms.segment_rooms`) the object is
+  reached from, which puts it on the object's open side rather than behind the wall it stands on,
+- sees the object from the robot's eye height through the mapped voxels
+  (:mod:`capnav.planning.sight`: the TV on the wall is seen over the cabinet under it),
+
+and takes the cheapest such cell by path cost from the robot. The search settles candidates in
+cost order and stops at the first that passes (:class:`capnav.planning.nearest.NearestSearch`), so
+a goal costs the cells cheaper than it, not a whole-grid search. When no cell passes, the rule is
+relaxed one condition at a time and the reason says which one failed.
 """
 
 from __future__ import annotations
@@ -15,19 +26,21 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from capnav.core.errors import InputError, NotFoundError
-from capnav.core.footprint import footprint_distance
-from capnav.core.grid import OccupancyGrid
+from capnav.core.errors import InputError
+from capnav.core.grid import FREE, OCCUPIED, OccupancyGrid
 from capnav.planning.config import PlannerConfig
 from capnav.planning.costmap import Costmap, build_costmap, locate_start
-from capnav.planning.search import cost_field
-from capnav.planning.sight import sees_footprint
+from capnav.planning.nearest import NearestSearch
+from capnav.planning.polygon import polygon_distance
+from capnav.planning.sight import HeightColumns, SightTest
 
 
 @dataclass(frozen=True)
 class GoalPose:
     """Where to stop: ``xy`` world, ``yaw`` facing the object, its grid ``cell``; whether it lies
-    within ``reach`` of the footprint, why it was chosen, and its distance / path cost (m)."""
+    within ``reach`` of the footprint, why it was chosen, and its distance / path cost (m).
+    ``in_sight`` / ``in_room``: whether the cell sees the object and lies in the object's room
+    (None when not asked: the paper's rule, or no room found around the object)."""
 
     xy: NDArray[np.float64]
     yaw: float
@@ -36,11 +49,14 @@ class GoalPose:
     reason: str
     distance_to_object: float
     path_cost: float
+    in_sight: bool | None = None
+    in_room: bool | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {"xy": [round(float(v), 4) for v in self.xy], "yaw": round(self.yaw, 4), "cell": list(self.cell),
                 "reached_within_reach": self.reached_within_reach, "reason": self.reason,
-                "distance_to_object": round(self.distance_to_object, 4), "path_cost": round(self.path_cost, 4)}
+                "distance_to_object": round(self.distance_to_object, 4), "path_cost": round(self.path_cost, 4),
+                "in_sight": self.in_sight, "in_room": self.in_room}
 
 
 def check_footprint(footprint: object) -> NDArray[np.float64]:
@@ -52,62 +68,139 @@ def check_footprint(footprint: object) -> NDArray[np.float64]:
     return fp
 
 
+def room_labels(cm: Costmap) -> NDArray[np.int32]:
+    """Free-space regions of the costmap's grid (one label per room, -1 on walls), computed once per
+    costmap: the walkable domain is every cell not seen occupied (furniture is occupied, but a room
+    is one region around it once doorways are cut by the erosion)."""
+    labels = cm.cache.get("rooms")
+    if labels is None:
+        from capnav.language.rooms import fill_gaps, segment_rooms
+
+        labels = segment_rooms(fill_gaps(cm.occ.cells) != OCCUPIED, cm.spec)
+        cm.cache["rooms"] = labels
+    return np.asarray(labels)
+
+
 def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], start_xy: Any,
-                config: PlannerConfig | None = None, costmap: Costmap | None = None) -> GoalPose:
-    """Nearest reachable free cell within ``reach - goal_margin`` of the footprint; else, among the
-    cells within ``config.reach``, the nearest reachable one of those closest to the object (the
-    margin left absorbs the mapped footprint's error); else the reachable cell closest to the
-    object, with the reason.
+                config: PlannerConfig | None = None, costmap: Costmap | None = None, *,
+                z_range: tuple[float, float] | None = None, columns: HeightColumns | None = None) -> GoalPose:
+    """The cheapest cell (path cost from ``start_xy``) within ``reach - goal_margin`` of the
+    footprint that meets the goal rule (module notes); else, relaxing one condition at a time, the
+    cells within ``reach``, in sight from the next room, in the room but out of sight, any seen free
+    cell within reach; else the reachable free cell closest to the object. The reason says which.
 
-    With ``config.prefer_line_of_sight`` the same two tiers are first tried among the cells that
-    see the footprint on the map; when none within reach does, the reason says so.
-
-    Raises ``NotFoundError`` when nothing at all is reachable from the start.
+    ``z_range`` (m above the floor) is the object's height; ``columns`` (default: the costmap's)
+    the map's observed heights for 3D sight. Without them every occupied cell blocks sight.
+    When no seen free cell is reachable the goal is the start cell, with the reason.
     """
     cfg = config or PlannerConfig()
     fp = check_footprint(target_footprint)
-    cm = costmap if costmap is not None else build_costmap(occ, cfg)
+    cm = costmap if costmap is not None else build_costmap(occ, cfg, columns)
+    cols = columns if columns is not None else cm.columns
     spec = cm.spec
     s_cell, _ = locate_start(cm, start_xy, cfg)
-    field, _ = cost_field(cm.weights, s_cell)
-    reach_r, reach_c = np.nonzero(np.isfinite(field))
-    rc = np.stack([reach_r, reach_c], axis=1)
-    centres = spec.to_world(rc)
-    cost = field[reach_r, reach_c] * spec.resolution
     # Only cells in the footprint's box grown by the reach can be within reach: measure those.
-    lo, hi = fp.min(axis=0) - cfg.reach, fp.max(axis=0) + cfg.reach
-    near = np.nonzero(((centres >= lo) & (centres <= hi)).all(axis=1))[0]
-    dist = np.full(len(rc), np.inf)
-    dist[near] = _distances(centres[near], fp)
-    tiers = ((cfg.reach - cfg.goal_margin, "the nearest reachable free cell {d:.2f} m from the object"),
-             (cfg.reach, "the nearest reachable free cell within reach ({d:.2f} m from the object; none "
-                         f"within {cfg.reach - cfg.goal_margin:.2f} m)"))
-    within = np.nonzero(dist <= cfg.reach)[0]
-    blind = ""
-    if cfg.prefer_line_of_sight and within.size:
-        seen = np.zeros(len(rc), dtype=bool)
-        seen[within] = sees_footprint(cm.occ, fp, rc[within], polygon_centroid(fp))
-        for k, (limit, why) in enumerate(tiers):
-            ok = np.nonzero(seen & (dist <= limit))[0]
-            if ok.size:
-                i = _pick(ok, cost, dist, k > 0, spec.resolution)
-                return _pose(rc[i], centres[i], fp, True, why.format(d=dist[i]) + ", in sight of it on the map",
-                             float(dist[i]), float(cost[i]))
-        blind = f"; none of the {within.size} reachable cells within reach sees the object on the map"
-    for k, (limit, why) in enumerate(tiers):
-        ok = np.nonzero(dist <= limit)[0]
-        if ok.size:
-            i = _pick(ok, cost, dist, k > 0, spec.resolution)
-            return _pose(rc[i], centres[i], fp, True, why.format(d=dist[i]) + blind, float(dist[i]), float(cost[i]))
-    if len(rc) == 0:  # pragma: no cover - the start cell itself is always reachable
-        raise NotFoundError("no cell is reachable from the start")
+    lo = np.clip(spec.to_cell(fp.min(axis=0) - cfg.reach), 0, [spec.rows - 1, spec.cols - 1])
+    hi = np.clip(spec.to_cell(fp.max(axis=0) + cfg.reach), 0, [spec.rows - 1, spec.cols - 1])
+    rr, cc = np.mgrid[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1]
+    rc = np.stack([rr.ravel(), cc.ravel()], axis=1)
+    centres = spec.to_world(rc)
     dist = _distances(centres, fp)
-    best = dist.min()
-    ok = np.nonzero(dist <= best + 0.5 * spec.resolution)[0]
-    i = int(ok[np.argmin(cost[ok])])
+    win = (slice(lo[0], hi[0] + 1), slice(lo[1], hi[1] + 1))
+    free = (cm.occ.cells[win].ravel() == FREE) & np.isfinite(cm.weights[win].ravel())
+    within = free & (dist <= cfg.reach)
+    near = within & (dist <= cfg.reach - cfg.goal_margin)
+    person = cfg.prefer_line_of_sight
+    region = -1
+    in_room = np.ones(len(rc), dtype=bool)
+    if person and within.any():
+        labels = room_labels(cm)
+        from capnav.language.rooms import object_region
+
+        region = object_region(labels, spec, fp.min(axis=0), fp.max(axis=0))
+        if region >= 0:
+            in_room = _inside_region(labels[win], region,
+                                     cfg.robot_radius / spec.resolution).ravel()
+    centroid = polygon_centroid(fp)
+    sight = SightTest(cm.occ, fp, centroid, lo, hi, cols, z_range, cfg.eye_height) if person else None
+    room_flag = None if region < 0 or not person else True
+
+    target = np.zeros(cm.weights.shape, dtype=bool)
+    target[win] = (near & in_room).reshape(rr.shape)
+    if "min_weight" not in cm.cache:
+        finite = cm.weights[np.isfinite(cm.weights)]
+        cm.cache["min_weight"] = float(finite.min()) if finite.size else 1.0
+    search = NearestSearch(cm.weights, s_cell, target, (int(lo[0]), int(lo[1]), int(hi[0]), int(hi[1])),
+                           cm.cache["min_weight"])
+    while (hit := search.next()) is not None:
+        cell, g = hit
+        if sight is None or bool(sight(np.array([cell]))[0]):
+            i = int((cell[0] - lo[0]) * (hi[1] - lo[1] + 1) + cell[1] - lo[1])
+            why = f"the nearest reachable free cell {dist[i]:.2f} m from the object"
+            if person:
+                why += (", in the object's room" if region >= 0 else "") + ", in sight of it on the map"
+            return _pose(rc[i], centres[i], fp, True, why, float(dist[i]), g * spec.resolution,
+                         None if sight is None else True, room_flag)
+    # Nothing passes the whole rule: the costs of every reachable cell, then relax one condition at a time.
+    field = search.finish()
+    cost = field[win].ravel() * spec.resolution
+    reach_ok = np.isfinite(cost)
+    within &= reach_ok
+    near &= reach_ok
+    seen = np.zeros(len(rc), dtype=bool)
+    if sight is not None and within.any():
+        seen[within] = sight(rc[within])
+    short = f"none within {cfg.reach - cfg.goal_margin:.2f} m"
+    tiers: list[tuple[NDArray[np.bool_], str, bool | None, bool | None]] = []
+    if person:
+        where = ", in the object's room" if region >= 0 else ""
+        tiers += [(within & in_room & seen, f"{where}, in sight of it on the map", True, room_flag)]
+        if region >= 0:
+            tiers.append((within & seen, ", in sight of it from outside its room (no cell of its room within "
+                                         "reach sees it or is reachable)", True, False))
+            tiers.append((within & in_room, ", in the object's room but out of sight (no reachable cell within "
+                                            "reach sees it on the map)", False, True))
+        tiers.append((within, ", neither in its room nor in sight of it (no reachable cell within reach is)",
+                      False, False if region >= 0 else None))
+    else:
+        tiers.append((within, "", None, None))
+    for ok, why, in_sight, room in tiers:
+        if ok.any():
+            k = ok & near
+            i = _pick(np.nonzero(k if k.any() else ok)[0], cost, dist, not k.any(), spec.resolution)
+            what = ("the nearest reachable free cell" if k.any() else
+                    f"the nearest reachable free cell within reach ({short})")
+            return _pose(rc[i], centres[i], fp, True, f"{what} {dist[i]:.2f} m from the object{why}",
+                         float(dist[i]), float(cost[i]), in_sight, room)
+    # Out of reach: the reachable seen free cell closest to the object, over the whole grid.
+    ok_all = np.isfinite(field) & (cm.occ.cells == FREE)
+    if not ok_all.any():  # stay where the robot stands rather than stop on floor nobody saw
+        xy = spec.to_world(np.asarray(s_cell))
+        d0 = float(_distances(xy.reshape(1, 2), fp)[0])
+        return _pose(np.asarray(s_cell), xy, fp, d0 <= cfg.reach,
+                     f"no seen free cell is reachable from the start (only unknown space); staying {d0:.2f} m "
+                     "from the object", d0, 0.0, None, None)
+    r_all = np.argwhere(ok_all)
+    c_all = spec.to_world(r_all)
+    d_all = _distances(c_all, fp)
+    best = d_all.min()
+    nearest = np.nonzero(d_all <= best + 0.5 * spec.resolution)[0]
+    cost_all = field[r_all[:, 0], r_all[:, 1]] * spec.resolution
+    i = int(nearest[np.argmin(cost_all[nearest])])
     why = (f"no reachable free cell within {cfg.reach:.2f} m of the object; closest reachable cell is "
-           f"{dist[i]:.2f} m away")
-    return _pose(rc[i], centres[i], fp, False, why, float(dist[i]), float(cost[i]))
+           f"{d_all[i]:.2f} m away")
+    return _pose(r_all[i], c_all[i], fp, False, why, float(d_all[i]), float(cost_all[i]), None, None)
+
+
+def _inside_region(labels: NDArray[np.int32], region: int, radius_cells: float) -> NDArray[np.bool_]:
+    """Cells of ``region`` whose robot disk lies in it: not within the robot's radius of another
+    region's cell (a doorway is shared by the two rooms it joins; standing in it is in neither)."""
+    from scipy import ndimage
+
+    other = (labels >= 0) & (labels != region)
+    if not other.any():
+        return np.asarray(labels == region)
+    return np.asarray((labels == region) & (ndimage.distance_transform_edt(~other) > radius_cells))
 
 
 def _pick(ok: NDArray[np.intp], cost: NDArray[np.float64], dist: NDArray[np.float64], closest: bool,
@@ -121,12 +214,8 @@ def _pick(ok: NDArray[np.intp], cost: NDArray[np.float64], dist: NDArray[np.floa
     return int(ok[np.argmin(cost[ok])])
 
 
-def _distances(points: NDArray[np.float64], fp: NDArray[np.float64], chunk: int = 65536) -> NDArray[np.float64]:
-    """Footprint distance in chunks so a large map never builds a huge (N, K, 2) temporary."""
-    out = np.empty(len(points), np.float64)
-    for a in range(0, len(points), chunk):
-        out[a:a + chunk] = footprint_distance(points[a:a + chunk], fp)
-    return out
+def _distances(points: NDArray[np.float64], fp: NDArray[np.float64]) -> NDArray[np.float64]:
+    return polygon_distance(points, fp)
 
 
 def polygon_centroid(fp: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -143,8 +232,9 @@ def polygon_centroid(fp: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def _pose(cell: NDArray[np.intp], xy: NDArray[np.float64], fp: NDArray[np.float64], within: bool, reason: str,
-          dist: float, cost: float) -> GoalPose:
+          dist: float, cost: float, in_sight: bool | None, in_room: bool | None) -> GoalPose:
     centre = polygon_centroid(fp)
     d = centre - xy
     yaw = float(np.arctan2(d[1], d[0])) if np.hypot(*d) > 1e-9 else 0.0
-    return GoalPose(np.asarray(xy, dtype=np.float64), yaw, (int(cell[0]), int(cell[1])), within, reason, dist, cost)
+    return GoalPose(np.asarray(xy, dtype=np.float64), yaw, (int(cell[0]), int(cell[1])), within, reason, dist, cost,
+                    in_sight, in_room)

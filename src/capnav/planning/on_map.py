@@ -22,7 +22,8 @@ from capnav.core.grid import FREE, UNKNOWN, OccupancyGrid
 from capnav.planning.config import PlannerConfig
 from capnav.planning.costmap import build_costmap, locate_start
 from capnav.planning.goal import GoalPose, select_goal
-from capnav.planning.path import PlannedPath, plan_path
+from capnav.planning.path import PlannedPath, floor_along, plan_path
+from capnav.planning.sight import map_columns, object_heights
 
 if TYPE_CHECKING:
     from capnav.mapping.cmap import CameraTrajectory, CapNavMap
@@ -102,11 +103,16 @@ class MapNavigation:
     reason: str = ""
     notes: list[str] = field(default_factory=list)
     reach: float = PlannerConfig.reach
+    through_unknown: bool = False  # a path over unknown space is accepted (else it is not ok)
+    seen_free_m: float = 0.0  # of the path's length, over seen free floor ...
+    unknown_m: float = 0.0  # ... and over unknown space
 
     @property
     def ok(self) -> bool:
-        """A path to a goal pose within reach of the chosen object."""
-        return self.path is not None and self.goal is not None and self.goal.reached_within_reach
+        """A path to a goal pose within reach of the chosen object, over seen free floor only
+        unless ``through_unknown``."""
+        return self.path is not None and self.goal is not None and self.goal.reached_within_reach \
+            and (self.through_unknown or self.unknown_m <= 0.0)
 
     def to_dict(self) -> dict[str, Any]:
         g = self.goal
@@ -114,45 +120,82 @@ class MapNavigation:
                 "start": {"x": round(self.start[0], 4), "y": round(self.start[1], 4), "yaw": round(self.start[2], 4),
                           "source": self.start_source},
                 "goal": None if g is None else {"x": round(float(g.xy[0]), 4), "y": round(float(g.xy[1]), 4),
-                                                "yaw": round(g.yaw, 4), **g.to_dict()},
-                "path": None if self.path is None else self.path.to_dict(), "notes": list(self.notes),
+                                                "yaw": round(g.yaw, 4), "ok": g.reached_within_reach, **g.to_dict()},
+                "path": None if self.path is None else {
+                    **self.path.to_dict(), "seen_free_m": round(self.seen_free_m, 4),
+                    "unknown_m": round(self.unknown_m, 4),
+                    "seen_free_fraction": round(self.seen_free_m / max(self.seen_free_m + self.unknown_m, 1e-12), 4)},
+                "notes": list(self.notes),
                 "retrieval": self.query.to_dict()}
 
 
 def navigate_on_map(cmap: CapNavMap, retriever: Retriever, instruction: str,
                     start: tuple[float, float, float] | None = None, config: PlannerConfig | None = None,
-                    path_free_radius: float = PATH_FREE_RADIUS) -> MapNavigation:
+                    path_free_radius: float = PATH_FREE_RADIUS, through_unknown: bool = False) -> MapNavigation:
     """Retrieve the described object, choose a goal pose within reach of it, plan A* to it.
 
     Bad input (no start and no camera path, a start off the map or inside an obstacle) raises
-    ``InputError``; no object, no goal within reach or no path gives ``ok=False`` with the reason.
+    ``InputError``; no object, no goal within reach or no path gives ``ok=False`` with the reason,
+    and so does a path that crosses unknown space, unless ``through_unknown``.
     """
     cfg = config or PlannerConfig()
     source = "--start"
     if start is None:
         start, source = camera_start(cmap.trajectory)
     occ, notes = planning_grid(cmap, path_free_radius)
-    cm = build_costmap(occ, cfg)
     xy = (start[0], start[1])
+    # The robot stands on the floor under it, seen or not.
+    occ, n_under = free_along_path(occ, np.array([xy]), cfg.robot_radius)
+    if n_under:
+        notes.append(f"{n_under} unknown cells under the robot at the start counted as free")
+    cm = build_costmap(occ, cfg, map_columns(cmap))
     locate_start(cm, xy, cfg)  # a start off the map or in an obstacle is the user's error: raise now
     query = retriever.query(instruction, robot_xy=xy)
-    out = MapNavigation(instruction, query, start, source, occ, notes=notes, reach=cfg.reach)
+    out = MapNavigation(instruction, query, start, source, occ, notes=notes, reach=cfg.reach,
+                        through_unknown=through_unknown)
     if not query.found or query.chosen is None:
         out.reason = f"no object chosen: {query.reason}"
         return out
     try:
-        out.goal = select_goal(occ, query.chosen.footprint, xy, cfg, cm)
+        out.goal = select_goal(occ, query.chosen.footprint, xy, cfg, cm, z_range=object_heights(query.chosen))
         out.path = plan_path(occ, xy, out.goal.xy, cfg, cm)
     except CapNavError as e:
         out.reason = f"no path to object {query.chosen.id} ({query.chosen.label}): {e}"
         return out
+    out.seen_free_m, out.unknown_m = floor_along(occ, out.path.waypoints)
+    if out.unknown_m > 0 and not through_unknown:
+        _over_seen_floor(out, occ, query.chosen, xy, cfg, cm.columns)
     out.notes += out.path.notes
     if out.goal.reached_within_reach:
         out.reason = (f"A* path of {out.path.length_m:.2f} m to {out.goal.reason} (grid {cm.spec.resolution:.2f} m, "
                       f"obstacles inflated by {cfg.inflation:.2f} m)")
+        if out.unknown_m > 0:
+            out.reason = (f"the path crosses {out.unknown_m:.2f} m of unknown space (of {out.path.length_m:.2f} m): "
+                          + ("accepted (--through-unknown); " if through_unknown else
+                             "not planned over floor nobody saw (pass --through-unknown to accept it); ")
+                          + out.reason)
     else:
         out.reason = f"the object is out of reach from the start: {out.goal.reason}"
     return out
+
+
+def _over_seen_floor(out: MapNavigation, occ: OccupancyGrid, chosen: Any, xy: tuple[float, float],
+                     cfg: PlannerConfig, columns: Any) -> None:
+    """The cheapest path crossed unknown space: plan again with unknown cells blocked, and keep
+    that plan when it still ends within reach (else the first stands, reported as not ok)."""
+    from dataclasses import replace
+
+    strict = replace(cfg, unknown_cost=None)
+    try:
+        cm = build_costmap(occ, strict, columns)
+        goal = select_goal(occ, chosen.footprint, xy, strict, cm, z_range=object_heights(chosen))
+        path = plan_path(occ, xy, goal.xy, strict, cm)
+    except CapNavError:
+        return
+    seen, unknown = floor_along(occ, path.waypoints)
+    if goal.reached_within_reach and unknown < out.unknown_m:
+        out.notes.append(f"planned over seen floor: the cheapest path crossed {out.unknown_m:.2f} m of unknown space")
+        out.goal, out.path, out.seen_free_m, out.unknown_m = goal, path, seen, unknown
 
 
 def write_outputs(nav: MapNavigation, cmap: CapNavMap, out_dir: str | Path, stem: str = "navigate"

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -9,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.core.errors import NotFoundError
-from capnav.core.grid import OccupancyGrid
+from capnav.core.grid import FREE, OccupancyGrid
 from capnav.planning.backends import BACKENDS
 from capnav.planning.config import PlannerConfig
 from capnav.planning.costmap import Costmap, build_costmap, locate_goal, locate_start
@@ -39,6 +40,33 @@ class PlannedPath:
 def polyline_length(xy: NDArray[np.floating]) -> float:
     return float(np.linalg.norm(np.diff(np.asarray(xy, dtype=np.float64), axis=0), axis=1).sum()) if len(xy) > 1 \
         else 0.0
+
+
+def floor_along(occ: OccupancyGrid, waypoints: NDArray[np.floating]) -> tuple[float, float]:
+    """Metres of the polyline ``waypoints`` (M, 2) over seen free floor and over unknown space
+    (sampled at a tenth of a cell; off-map and occupied samples count as unknown). A one-cell
+    unsampled gap between seen cells counts as seen (:func:`capnav.language.rooms.fill_gaps`)."""
+    from capnav.language.rooms import fill_gaps
+
+    p = np.asarray(waypoints, dtype=np.float64).reshape(-1, 2)
+    if len(p) < 2:
+        return 0.0, 0.0
+    cells = fill_gaps(occ.cells)
+    seen = unknown = 0.0
+    step = 0.1 * occ.spec.resolution
+    for a, b in itertools.pairwise(p):
+        length = float(np.linalg.norm(b - a))
+        if length <= 0:
+            continue
+        n = max(1, int(np.ceil(length / step)))
+        mid = a + (b - a) * ((np.arange(n) + 0.5) / n)[:, None]
+        rc = occ.spec.to_cell(mid)
+        ok = occ.spec.inside(rc)
+        free = np.zeros(n, dtype=bool)
+        free[ok] = cells[rc[ok, 0], rc[ok, 1]] == FREE
+        seen += length * float(free.mean())
+        unknown += length * float(1.0 - free.mean())
+    return seen, unknown
 
 
 def plan_path(occ: OccupancyGrid, start_xy: XY, goal_xy: XY, config: PlannerConfig | None = None,

@@ -21,6 +21,7 @@ from capnav.core.grid import OccupancyGrid
 from capnav.eval.method import Agent, SceneContext, SubgoalOutcome
 from capnav.mapping.cmap import CapNavMap
 from capnav.planning import Costmap, PlannerConfig, build_costmap, navigate_to
+from capnav.planning.sight import map_columns, object_heights
 
 
 @dataclass
@@ -33,6 +34,7 @@ class Decision:
     reason: str = ""
     explanation: str = ""
     extra: dict[str, Any] = field(default_factory=dict)
+    z_range: tuple[float, float] | None = None  # the object's heights, for 3D lines of sight
 
 
 class PriorMapMethod(ABC):
@@ -76,7 +78,7 @@ class PriorMapMethod(ABC):
         ctx = self._ctx()
         key = f"costmap/{self.planner!r}"
         if key not in ctx.cache:
-            ctx.cache[key] = build_costmap(self.occ, self.planner)
+            ctx.cache[key] = build_costmap(self.occ, self.planner, map_columns(self.cmap))
         cm: Costmap = ctx.cache[key]
         return cm
 
@@ -97,7 +99,8 @@ class PriorMapMethod(ABC):
         query_time = time.perf_counter() - t0
         if isinstance(decision, str):
             return SubgoalOutcome(found=False, reason=decision, query_time_s=query_time)
-        nav = navigate_to(agent, self.occ, decision.footprint, self.planner, costmap=self.costmap())
+        nav = navigate_to(agent, self.occ, decision.footprint, self.planner, costmap=self.costmap(),
+                          z_range=decision.z_range)
         return SubgoalOutcome(
             found=True, reason=f"{decision.reason}; {nav.reason}" if decision.reason else nav.reason,
             target_xy=decision.target_xy, chosen_object=decision.chosen_object, query_time_s=query_time,
@@ -111,4 +114,4 @@ def object_decision(obj: Any, reason: str, explanation: str = "") -> Decision:
     if len(fp) == 0:
         fp = np.asarray(obj.position[:2], dtype=np.float64).reshape(1, 2)
     return Decision(fp, (float(obj.position[0]), float(obj.position[1])), int(obj.id), reason,
-                    explanation or (obj.caption or obj.label))
+                    explanation or (obj.caption or obj.label), z_range=object_heights(obj))
