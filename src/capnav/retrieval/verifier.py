@@ -273,6 +273,12 @@ class OfflineVerifier(Verifier):
         rank, _, why = self.color_fit(q, obj, words)
         return rank, why
 
+    def observed_colors(self, q: ParsedQuery, obj: MapObject) -> list[ColorCluster]:
+        """The colours a spoken colour is judged against: the pot's for "the plant in the blue
+        pot" when they were measured, else the object's ([] when none was measured)."""
+        cols = self.base_colors(obj) if re.search(r"\bpot\b", q.text.lower()) else []
+        return cols or self.colors(obj)
+
     def color_fit(self, q: ParsedQuery, obj: MapObject, words: list[str] | None = None) -> tuple[float, float, str]:
         """(ranking agreement, plausibility, why). The plausibility counts every shade the word
         covers in full: whether a person could call the object that colour at all ("the yellow
@@ -281,8 +287,7 @@ class OfflineVerifier(Verifier):
         words = q.colors if words is None else words
         if not words:
             return 0.0, 0.0, ""
-        cols = self.base_colors(obj) if re.search(r"\bpot\b", q.text.lower()) else []
-        cols = cols or self.colors(obj)
+        cols = self.observed_colors(q, obj)
         if not cols:
             return 0.0, 0.0, "its colour was not observed"
         floor = self.config.color_floor

@@ -7,6 +7,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.language.context import canonical_label
+from capnav.language.lexicon import load_lexicon
 from capnav.retrieval.constraints.base import RankingConstraint, RankState, ranking
 from capnav.retrieval.query import ParsedQuery
 
@@ -40,9 +41,18 @@ class Category(RankingConstraint):
             weights = np.ones(n)
         st.pool, st.weights = pool, weights
         if st.named and q.purpose is None and cfg.use_type_filter and len(pool) and not (weights[pool] >= 1.0).any():
-            # No instance of the named category: an alternative serves only a request whose observed
-            # attributes or landmark it shows ("the round wooden table" -> a round coffee table),
-            # never a bare name ("the desk" is not the kitchen table). A purpose names several.
+            # No instance of the named category: a stand-in serves only when the named word is its
+            # hypernym in the lexicon (a coffee table is a table; a table is no desk, a sofa no
+            # bed), and then only for a request whose observed attributes or landmark it shows
+            # ("the round wooden table" -> a round coffee table), never a bare name. A purpose
+            # names several categories and is not restricted.
+            kinds = stand_ins(q)
+            others = sorted({r.cats[int(i)] for i in st.pool} - kinds)
+            st.keep(np.array([r.cats[int(i)] in kinds for i in st.pool], dtype=bool))
+            if others:
+                st.notes.append(f"no {q.category or q.target_phrase} in the map; "
+                                f"{', '.join(others)} {'is' if len(others) == 1 else 'are'} not a kind of "
+                                f"{q.category or q.target_phrase} in the lexicon")
             if q.shapes:
                 st.keep(np.array([all(w.lower() in (r.objects[i].caption or "").lower() for w in q.shapes)
                                   for i in st.pool], dtype=bool))
@@ -62,3 +72,22 @@ class Category(RankingConstraint):
         if q.category is not None:
             w[r.of_category(q.category)] = 1.0
         return w
+
+
+def stand_ins(q: ParsedQuery) -> set[str]:
+    """Categories that may answer for the named one when the map has none of it: its hyponyms in
+    the lexicon (``kind_of``), and the other senses of a word of the request (a commode may be a
+    dresser). Not the more general categories, nor siblings: "the desk" is never the table.
+
+    The category table wins over WordNet's tree where they disagree: WordNet files "settee" under
+    "bench", but the table makes settee a sofa, and "bench" names no category, so no sofa (nor a
+    bed) ever stands in for a bench."""
+    lex = load_lexicon()
+    out: set[str] = set()
+    if q.category is not None:
+        out |= {c for c, rel in lex.relations.get(q.category, {}).items() if rel.get("kind_of")}
+    words = q.target_phrase.lower().split()
+    for n in (1, 2, 3):
+        for k in range(len(words) - n + 1):
+            out |= set(lex.form_alternatives.get(" ".join(words[k:k + n]), {}))
+    return {canonical_label(c) for c in out}

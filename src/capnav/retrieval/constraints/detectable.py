@@ -1,0 +1,54 @@
+"""What the map's detector can see: a request for a category its closed vocabulary lacks (a
+cabinet, for a COCO model) is "not found" because the map cannot contain one, which is not the
+same answer as "there is none". The vocabulary is the map's ``meta["detector_labels"]``; maps made
+before it was recorded give it through their COCO detector's id (``classes=indoor|all``)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from capnav.retrieval.constraints.base import RankingConstraint, RankState, ranking
+from capnav.retrieval.query import ParsedQuery
+
+_COCO_BACKENDS = ("yolo-fastest:", "centernet:", "coco:")
+
+
+def detector_labels(meta: dict[str, Any]) -> frozenset[str] | None:
+    """The labels the map's detector could output, or None when any category could come out
+    (the simulator's detector, an open vocabulary, a map that does not say)."""
+    if "detector_labels" in meta:
+        return frozenset(str(x) for x in meta["detector_labels"])
+    det = str(meta.get("detector", ""))
+    if det.startswith(_COCO_BACKENDS):
+        classes = next((p.split("=", 1)[1] for p in det.split(":") if p.startswith("classes=")), None)
+        if classes in ("indoor", "all"):
+            from capnav.perception.coco import class_table
+
+            return frozenset(t[1] for t in class_table(classes) if t is not None)
+    return None
+
+
+@ranking
+class Detectable(RankingConstraint):
+    kind = "detectable"
+    order = 15  # after the category set the pool up, before anything orders it
+
+    @staticmethod
+    def applies(q: ParsedQuery) -> bool:
+        return q.category is not None and q.purpose is None
+
+    def rank(self, st: RankState) -> None:
+        r, q = st.r, st.q
+        assert q.category is not None
+        if len(r.of_category(q.category)):
+            return
+        labels = detector_labels(getattr(r.cmap, "meta", {}) or {})
+        if labels is None or q.category in labels:
+            return
+        det = str(r.cmap.meta.get("detector", "the detector")).split(":")[0]
+        why = (f"the map's detector ({det}) has no '{q.category}' class, so the map cannot contain "
+               f"{'an' if q.category[:1] in 'aeiou' else 'a'} {q.category}")
+        if st.refusal is not None or not len(st.pool) or not (st.weights[st.pool] > 0).any():
+            st.refuse(self.kind, why)
+        else:
+            st.notes.append(why)
