@@ -229,3 +229,39 @@ def test_concurrent_and_interrupted_updates_leave_the_map_intact(visits: dict[st
     res = runner.invoke(app, args)  # the lock died with its holder: the update goes through
     assert res.exit_code == 0, res.output
     assert len(load_map(mp).retired) == 2
+
+
+def test_objects_command_and_captions_of_changed_objects_only(visits: dict[str, Path], tmp_path: Path) -> None:
+    import json
+
+    from capnav.language import create_captioner, create_embedder, describe_map
+
+    m1 = load_map(visits["m1.capnav"])
+    cap, emb = create_captioner("offline"), create_embedder("minilm")
+    describe_map(m1, DatasetReader(visits["v1"]), cap, emb, progress=False)
+    m2, rep = update_map(m1, DatasetReader(visits["v2"]), _det(), _enc(), progress=False)
+    p = save_map(m2, tmp_path / "m2.capnav")
+    before = {o.id: o.caption for o in m2.objects}
+    d = describe_map(m2, DatasetReader(visits["v2"]), cap, emb, progress=False)
+    # Views are chosen again only for moved and new objects; the offline captioner's words also depend
+    # on the room and the neighbours, so its cache decides the rest; only changed words are embedded.
+    assert d.views_selected == len(rep.moved) + len(rep.born), d.to_dict()
+    assert d.captions_cached >= 1
+    assert d.embeddings_new == sum(o.caption != before[o.id] for o in m2.objects), d.to_dict()
+    assert all(o.caption and o.embedding is not None for o in m2.objects)
+
+    runner = CliRunner()
+    res = runner.invoke(app, ["objects", str(p), "--json"])
+    assert res.exit_code == 0, res.output
+    listed = json.loads(res.output)
+    assert [o["id"] for o in listed["objects"]] == [o.id for o in m2.objects] and "retired" not in listed
+    row = listed["objects"][0]
+    assert {"id", "label", "votes", "size", "position", "caption", "views", "last_seen"} <= set(row)
+    res = runner.invoke(app, ["objects", str(p), "--json", "--history"])
+    h = json.loads(res.output)
+    kinds = {(c["event"], c["id"]) for c in h["changes"]}
+    assert kinds == ({("moved", i) for i in rep.moved} | {("retired", i) for i in rep.retired}
+                     | {("born", i) for i in rep.born})
+    assert [r["id"] for r in h["retired"]] == rep.retired and len(h["recordings"]) == 2
+    res = runner.invoke(app, ["objects", str(p), "--history"])
+    assert res.exit_code == 0 and "moved from" in res.output and "gone from" in res.output

@@ -66,6 +66,7 @@ def register(app: typer.Typer) -> None:
         save_map(cmap, out)
         con = make_console(stderr=True)
         con.print(f"{out}: {rep.objects} objects, {rep.captions_new} new captions, {rep.captions_cached} cached, "
+                  f"{rep.embeddings_new} embedded, "
                   f"{len(rep.fallbacks)} fallbacks; captioner {cap.model_id}, embedder {emb.model_id} "
                   f"({', '.join(f'{k} {v:.1f} s' for k, v in rep.seconds.items())})", highlight=False)
         for oid, why in rep.fallbacks[:10]:

@@ -29,12 +29,14 @@ class DescribeReport:
     views_selected: int = 0
     captions_new: int = 0
     captions_cached: int = 0
+    embeddings_new: int = 0
     fallbacks: list[tuple[int, str]] = field(default_factory=list)
     seconds: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         return {"objects": self.objects, "views_selected": self.views_selected, "captions_new": self.captions_new,
-                "captions_cached": self.captions_cached, "fallbacks": [list(f) for f in self.fallbacks],
+                "captions_cached": self.captions_cached,
+                "embeddings_new": self.embeddings_new, "fallbacks": [list(f) for f in self.fallbacks],
                 "seconds": self.seconds}
 
 
@@ -57,6 +59,7 @@ def describe_map(cmap: CapNavMap, reader: FrameReader | None, captioner: Caption
     scene = SceneContext(cmap.objects, cmap.occupancy, context_config or ContextConfig(),
                          store=cmap.caches.setdefault(context.CACHE_KEY, {}))
     cache = cmap.caches.setdefault("captions", {})
+    before = {o.id: o.caption for o in cmap.objects}
     for obj in track(cmap.objects, f"captioning ({captioner.model_id})", enabled=progress):
         key = captioner.cache_key(obj, scene)
         hit = cache.get(key)
@@ -81,12 +84,15 @@ def describe_map(cmap: CapNavMap, reader: FrameReader | None, captioner: Caption
         attrs[str(obj.id)]["shapes"] = namer.shapes(obj)
         attrs[str(obj.id)]["surface"] = namer.surface(obj).to_list()
     t2 = time.perf_counter()
-    texts = [o.caption or "" for o in cmap.objects]
-    if texts:
-        vecs = embedder.embed(texts)
-        for o, v in zip(cmap.objects, vecs, strict=True):
+    # Only captions that changed are embedded again (after a map update: moved and new objects).
+    todo_emb = [o for o in cmap.objects if o.embedding is None or o.embedding_model != embedder.model_id
+                or o.caption != before[o.id]]
+    if todo_emb:
+        vecs = embedder.embed([o.caption or "" for o in todo_emb])
+        for o, v in zip(todo_emb, vecs, strict=True):
             o.embedding = v.copy()
             o.embedding_model = embedder.model_id
+    rep.embeddings_new = len(todo_emb)
     # Requests by purpose compare to every category's glosses: embedded once here, not per query.
     cmap.caches[purpose.CACHE_KEY] = purpose.gloss_index(embedder).to_store()
     t3 = time.perf_counter()
