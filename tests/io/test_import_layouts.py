@@ -161,3 +161,45 @@ def test_depth_in_the_wrong_scale_warns(tmp_path: Path, frames: list[Frame]) -> 
                                    "--no-progress"])
     assert res.exit_code == 0, res.output + repr(res.exception)
     assert "warning: the cameras are 0.25 m above the floor found" in res.output and "--depth-scale" in res.output
+
+
+@pytest.fixture(scope="module")
+def walk() -> list[Frame]:
+    """Eight neighbouring views: a camera 1.25 m up, pitched 20 deg, stepping 8 cm and turning 3 deg a frame."""
+    import math
+
+    from capnav.core.geometry import look_at_pose
+    from capnav.sim import CameraConfig, LayoutConfig, SimConfig, Simulator
+
+    sim = Simulator.from_seed(0, SimConfig(layout=LayoutConfig(rooms=3), camera=CameraConfig(width=160, height=120)))
+    try:
+        x, y = sim.random_navigable_point(np.random.default_rng(2))
+        return [sim.render(look_at_pose(np.array([x + 0.08 * i, y + 0.03 * i, 1.25]), math.radians(40 + 3 * i),
+                                        math.radians(20)), index=i) for i in range(8)]
+    finally:
+        sim.close()
+
+
+@pytest.mark.parametrize("how,says", [
+    ("inverse", "the poses are world-to-camera"), ("gl", "OpenGL camera axes"), ("scale", "5 times too big")])
+def test_a_wrong_convention_is_refused_with_the_reason(tmp_path: Path, walk: list[Frame], how: str,
+                                                       says: str) -> None:
+    GL = np.diag([1.0, -1.0, -1.0, 1.0])
+    src = export("open3d", walk, tmp_path / "rec")
+    args = ["import", "auto", str(src), "-o", str(tmp_path / "ds"), "--no-progress"]
+    res = CliRunner().invoke(app, args)
+    assert res.exit_code == 0 and "poses checked against depth" in res.output, res.output
+    poses = [W @ f.T_wc for f in walk]
+    if how == "inverse":
+        poses = [np.linalg.inv(T) for T in poses]
+    elif how == "gl":
+        poses = [T @ GL for T in poses]
+    else:
+        args += ["--depth-scale", "5000"]
+    from capnav.io.open3d_log import log_text
+
+    (src / "trajectory.log").write_text(log_text(poses))
+    res = CliRunner().invoke(app, [*args, "--overwrite"])
+    assert res.exit_code != 0 and isinstance(res.exception, InputError)
+    msg = str(res.exception)
+    assert "do not fit together as read" in msg and says in msg and "as recorded" in msg, msg

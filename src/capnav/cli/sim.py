@@ -37,10 +37,17 @@ def register(app: typer.Typer) -> None:
             None, "--frame-offset", metavar="X,Y,YAW",
             help="write the poses in a world frame shifted by X,Y metres and turned YAW degrees (a robot "
                  "started elsewhere on another day; `capnav map --update` registers the recordings)"),
+        export: str | None = typer.Option(None, "--export", help="write the recording in another layout instead: "
+                                                                  "tum | open3d | 3dmatch | scannet (read back by "
+                                                                  "`capnav import auto`)"),
+        tilt: str | None = typer.Option(None, "--tilt", metavar="ROLL,PITCH,YAW",
+                                        help="with --export: turn the recording's world by these angles (degrees), "
+                                             "so an importer has to find up by itself"),
         overwrite: bool = typer.Option(False, "--overwrite", help="replace an existing dataset folder (kept "
                                                                   "until the new one is complete)"),
     ) -> None:
-        """Write a posed RGB-D dataset (with manifest.json and topdown.png) for one apartment."""
+        """Write a posed RGB-D dataset (with manifest.json and topdown.png) for one apartment, or with --export
+        the same recording in another tool's layout."""
         from capnav.core.console import make_console
         from capnav.core.errors import InputError
         from capnav.sim.changes import ChangeSpec
@@ -64,5 +71,5 @@ def register(app: typer.Typer) -> None:
                                  hfov=hfov, rooms=rooms, furniture=furniture, depth_noise=depth_noise,
                                  overwrite=overwrite, assets_dir=assets_dir, surface_items=surface_items,
                                  visit=visit, changes=spec,
-                                 change_seed=change_seed, frame_offset=offset)
+                                 change_seed=change_seed, frame_offset=offset, export=export, tilt=tilt)
         make_console().print(summary, markup=False, highlight=False)

@@ -147,3 +147,20 @@ def tilt_matrix(spec: str | tuple[float, float, float] | None) -> NDArray[np.flo
         raise InputError(f"--tilt must be three finite numbers ROLL,PITCH,YAW in degrees, got {spec!r}")
     W[:3, :3] = Rotation.from_euler("xyz", vals, degrees=True).as_matrix()
     return W
+
+
+def check_export_target(out: Path, overwrite: bool) -> None:
+    """``out`` may receive an export: absent, empty, or (with ``overwrite``) a recording of a known layout;
+    a folder holding anything else is never replaced."""
+    from capnav.core.errors import DatasetError
+    from capnav.io.layouts import detect
+
+    if out.exists() and not out.is_dir():
+        raise DatasetError(f"{out} exists and is not a folder")
+    if out.is_dir() and any(out.iterdir()):
+        if not overwrite:
+            raise DatasetError(f"{out} is not empty (pass --overwrite to replace it)")
+        try:
+            detect(out)
+        except InputError:
+            raise DatasetError(f"{out} holds no recording CapNav wrote; refusing to replace it") from None

@@ -23,6 +23,7 @@ from capnav.core.geometry import Intrinsics
 from capnav.core.progress import track
 from capnav.io.align import Alignment, floor_alignment
 from capnav.io.assoc import SkipLog
+from capnav.io.consistency import Consistency, check, pair_up
 from capnav.io.up_axis import CUES, UpConfig
 
 
@@ -92,6 +93,11 @@ class ImportReport:
                            "hand-held or robot camera: is the depth scale right (--depth-scale: units per metre)?")
         else:
             out.append("world frame kept as recorded (--up none)")
+        c = self.meta.get("consistency") or {}
+        if c.get("verdict") == "weak":
+            out.append(f"warning: poses against depth: {c['reason']}")
+        elif c.get("verdict") == "consistent":
+            out.append(f"poses checked against depth: {c['reason']}")
         for reason, n in self.skipped.counts().items():
             ex = "; ".join(f"{s.name}" + (f" ({s.detail})" if s.detail else "") for s in self.skipped.examples(reason))
             out.append(f"skipped {n}: {reason} (e.g. {ex})")
@@ -107,6 +113,16 @@ def select(frames: list[PlannedFrame], stride: int = 1, max_frames: int | None =
     return frames[::stride][:max_frames]
 
 
+def check_poses(rec: Recording, frames: list[PlannedFrame], shape: tuple[int, int]) -> Consistency:
+    """The reprojection check of ``capnav.io.consistency`` on neighbouring selected frames."""
+    pairs = pair_up([f.T_wc for f in frames])
+    wanted = [frames[k] for ij in pairs for k in ij]
+    got = {id(f): d for f, d in rec.load_depths(wanted) if d.shape == shape}
+    both = [(i, j) for i, j in pairs if id(frames[i]) in got and id(frames[j]) in got]
+    return check([got[id(frames[k])] for ij in both for k in ij], [frames[k].T_wc for ij in both for k in ij],
+                 rec.K)
+
+
 def import_recording(rec: Recording, out: str | Path, up: str = "auto", stride: int = 1,
                      max_frames: int | None = None, overwrite: bool = False, progress: bool = True,
                      align_frames: int = 30, floor: UpConfig | None = None) -> ImportReport:
@@ -120,15 +136,18 @@ def import_recording(rec: Recording, out: str | Path, up: str = "auto", stride: 
     if not frames:
         counts = ", ".join(f"{n} {r}" for r, n in rec.skipped.counts().items()) or "none in the recording"
         raise InputError(f"{rec.path}: no frame to import (skipped: {counts})")
-    pick = np.unique(np.round(np.linspace(0, len(frames) - 1, min(align_frames, len(frames)))).astype(int))
     shape = (rec.K.height, rec.K.width)
+    consistency = check_poses(rec, frames, shape)
+    if consistency.verdict == "refused":
+        raise InputError(f"{rec.path}: the poses and the depth do not fit together as read; {consistency.reason}")
+    pick = np.unique(np.round(np.linspace(0, len(frames) - 1, min(align_frames, len(frames)))).astype(int))
     views = ((d, f.T_wc) for f, d in rec.load_depths([frames[i] for i in pick]) if d.shape == shape)
     align = floor_alignment(views, rec.K, up, floor, poses=np.stack([f.T_wc for f in frames]))
 
     skipped = SkipLog(list(rec.skipped.skips))
     n_before = len(rec.skipped.skips)  # the reader counts frames it cannot load while they are written
     meta: dict[str, Any] = {"source": rec.kind, "recording": str(rec.path), **rec.meta,
-                            "alignment": align.to_meta()}
+                            "alignment": align.to_meta(), "consistency": consistency.to_meta()}
     sources: list[list[Any]] = []  # per written frame: where it came from
     with atomic_dir(out, overwrite=True) as tmp:  # the target was checked above
         w = DatasetWriter(tmp, rec.K, meta, write_gt=False)

@@ -36,7 +36,7 @@ def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride
                    config: SimConfig | None = None, assets_dir: str | Path | None = None, visit: int = 1,
                    changes: ChangeSpec | None = None, change_seed: int = 0,
                    frame_offset: tuple[float, float, float] | None = None,
-                   surface_items: bool = False) -> str:
+                   surface_items: bool = False, export: str | None = None, tilt: str | None = None) -> str:
     """Build apartment ``seed``, render its exploration pass into ``out``; returns a one-line summary.
 
     Writes ``out/manifest.json`` (scene truth, for evaluation) and ``out/topdown.png`` beside the frames.
@@ -45,11 +45,24 @@ def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride
     in another world frame, as a robot started elsewhere on another day would.
     ``surface_items`` puts 1-3 small things (cups, books, a laptop...) on each table, counter and
     shelf piece (``capnav.sim.surface_items``); the apartment's furniture stays the same.
+    ``export`` writes the frames in another tool's layout instead (``capnav.io.export``: tum, open3d,
+    3dmatch, scannet), with the poses in a world turned by ``tilt`` ("ROLL,PITCH,YAW" degrees), so an
+    importer has to find up itself; manifest.json beside them stays in the apartment's frame.
     """
+    from capnav.io.export import check_export_target, tilt_matrix, writer
     from capnav.viz.scene import draw_scene
 
     out = Path(out)
-    check_dataset_target(out, overwrite)
+    write_layout = writer(export) if export is not None else None
+    W = tilt_matrix(tilt)
+    if tilt is not None and export is None:
+        from capnav.core.errors import InputError
+
+        raise InputError("--tilt turns the world of an --export recording; give --export too")
+    if write_layout is None:
+        check_dataset_target(out, overwrite)
+    else:
+        check_export_target(out, overwrite)
     base = config if config is not None else SimConfig()
     cfg = replace(base, camera=replace(base.camera, width=width, height=height, hfov_deg=hfov)
                   if config is not None else CameraConfig(width=width, height=height, hfov_deg=hfov),
@@ -76,17 +89,24 @@ def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride
         t1 = time.perf_counter()
         # Built in a temporary sibling and swapped in whole: an interrupted --overwrite keeps the old one.
         with atomic_dir(out, overwrite=overwrite) as tmp:
-            with DatasetWriter(tmp, sim.intrinsics, meta) as writer:
-                for i, T in enumerate(track(poses, f"rendering seed {seed}", enabled=progress)):
-                    f = sim.render(T, index=i)
-                    if frame_offset is not None:
-                        f = replace(f, T_wc=to_rec @ f.T_wc)
-                    writer.write(f)
+            rendered = (sim.render(T, index=i) for i, T in enumerate(track(poses, f"rendering seed {seed}",
+                                                                          enabled=progress)))
+            if write_layout is None:
+                with DatasetWriter(tmp, sim.intrinsics, meta) as dataset:
+                    for f in rendered:
+                        if frame_offset is not None:
+                            f = replace(f, T_wc=to_rec @ f.T_wc)
+                        dataset.write(f)
+            else:
+                write_layout((replace(f, T_wc=W @ to_rec @ f.T_wc, gt_instance=None, gt_category=None)
+                              for f in rendered), sim.intrinsics, tmp)
             t_render = time.perf_counter() - t1
             sim.manifest.save(tmp / "manifest.json")
             traj = np.array([T[:2, 3] for T in poses]) if poses else None
             draw_scene(sim.manifest, tmp / "topdown.png", navigable=sim.navigable(), trajectory=traj)
         what = f"visit {visit} ({changes}) of " if visit > 1 else ""
+        if export is not None:
+            what = f"{export} layout{f', world tilted {tilt}' if tilt else ''}, " + what
         return (f"wrote {len(poses)} frames ({width}x{height}) of {what}apartment seed {seed} "
                 f"({len(sim.manifest.rooms)} rooms, {len(sim.manifest.objects)} objects) to {out} "
                 f"[build {t_build:.2f} s, render+write {t_render:.1f} s]")
