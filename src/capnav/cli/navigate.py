@@ -1,5 +1,7 @@
 """``capnav navigate MAP "instruction"``: retrieve, choose a goal pose, plan with A*; drive in the
-simulator when the map comes from ``capnav sim``, else write the goal and path for a robot stack."""
+simulator when the map comes from ``capnav sim``, else write the goal and path for a robot stack.
+A request of several goals ("the fridge, then the sofa") is planned or driven leg by leg, each
+from where the one before ended; a leg that fails ends the sequence and the command fails."""
 
 from __future__ import annotations
 
@@ -12,7 +14,7 @@ if TYPE_CHECKING:
     from rich.console import Console
 
     from capnav.mapping.cmap import CapNavMap
-    from capnav.retrieval import Retriever
+    from capnav.retrieval import ParsedQuery, Retriever
 
 
 def register(app: typer.Typer) -> None:
@@ -84,27 +86,101 @@ def register(app: typer.Typer) -> None:
         ver_kw = {"embedder": emb} if verifier == "offline" else {}
         retriever = Retriever(cmap, emb, create_verifier(verifier, **ver_kw))
         con = make_console(stderr=True)
+        from capnav.retrieval.query import parse_goals
+
+        goals = parse_goals(instruction, retriever.embedder)
         if drive is False or scene_seed is None:
-            _plan_only(con, cmap, retriever, instruction, given, out, map_file, through_unknown)
+            if len(goals) == 1:
+                _plan_only(con, cmap, retriever, instruction, given, out, map_file, through_unknown)
+            else:
+                _plan_legs(con, cmap, retriever, goals, given, out, through_unknown)
             return
         from capnav.eval.drive import random_start, run_instruction
         from capnav.io.rosmap import write_ros_map
         from capnav.sim import Simulator
 
+        legs = []
+        stopped = ""
         with Simulator.from_seed(int(scene_seed)) as sim:
             pose = given or random_start(sim, seed)
-            res = run_instruction(cmap, sim, retriever, instruction, pose, occupancy, out_dir=out)
-        q, nav = res.query, res.nav
-        con.print(f"chosen: {q.chosen.id if q.chosen else '-'} {q.chosen.caption if q.chosen else ''}", highlight=False)
-        con.print(f"why: {q.reason}", highlight=False)
-        if nav is not None:
-            colour = "green" if nav.reached else "red"
-            con.print(f"[{colour}]{'reached' if nav.reached else 'not reached'}[/]: {nav.reason}; "
-                      f"path {nav.path_length:.2f} m, {nav.replans} replans", highlight=False)
+            agent = sim.spawn_agent(*pose)
+            for k, goal in enumerate(goals):
+                if len(goals) > 1:
+                    con.print(f"[bold]goal {k + 1} of {len(goals)}[/]: {goal.text}", highlight=False)
+                res = run_instruction(cmap, sim, retriever, instruction if len(goals) == 1 else goal, None, occupancy,
+                                      out_dir=out, stem="navigate" if k == 0 else f"navigate_leg{k + 1}", agent=agent)
+                legs.append(res)
+                q, nav = res.query, res.nav
+                con.print(f"chosen: {q.chosen.id if q.chosen else '-'} {q.chosen.caption if q.chosen else ''}",
+                          highlight=False)
+                con.print(f"why: {q.reason}", highlight=False)
+                if nav is not None:
+                    colour = "green" if nav.reached else "red"
+                    con.print(f"[{colour}]{'reached' if nav.reached else 'not reached'}[/]: {nav.reason}; "
+                              f"path {nav.path_length:.2f} m, {nav.replans} replans", highlight=False)
+                if not res.reached:
+                    if k + 1 < len(goals):
+                        stopped = _stopped(k, len(goals), goal.text, "not reached")
+                    break
+        if len(goals) > 1 and legs[0].json is not None:
+            _add_legs(legs[0].json, [r.to_dict() for r in legs], len(goals), stopped,
+                      all(r.reached for r in legs) and len(legs) == len(goals))
         pgm, yml = write_ros_map(cmap.occupancy, out / "navigate_map.yaml")
-        con.print(f"{res.png}\n{res.json}\n{yml} (+ {pgm.name})", highlight=False)
-        if not res.reached:
+        con.print("\n".join(str(p) for r in legs for p in (r.png, r.json) if p is not None) + f"\n{yml} (+ {pgm.name})",
+                  highlight=False)
+        if stopped:
+            con.print(f"[red]stopped[/]: {stopped}", highlight=False)
+        if not (all(r.reached for r in legs) and len(legs) == len(goals)):
             raise typer.Exit(1)
+
+
+def _stopped(k: int, n: int, text: str, what: str) -> str:
+    return f"goal {k + 1} of {n} ({text!r}) {what}, so the {n - k - 1} goal(s) after it were not tried"
+
+
+def _add_legs(path: Path, legs: list[dict[str, object]], total: int, stopped: str, all_ok: bool) -> None:
+    """navigate.json of a sequence: the first leg's fields as for one goal, and every leg in
+    ``legs`` (each with its own goal, path and ``ok``); ``ok`` there means every leg succeeded."""
+    import json
+
+    from capnav.core.atomic import write_json
+
+    data = json.loads(path.read_text(encoding="utf-8"))
+    data.update({"ok": all_ok, "legs": legs, "goals_total": total, "stopped": stopped})
+    write_json(path, data)
+
+
+def _plan_legs(con: Console, cmap: CapNavMap, retriever: Retriever, goals: list[ParsedQuery],
+               start: tuple[float, float, float] | None, out: Path, through_unknown: bool = False) -> None:
+    """Several goals on a map alone: each leg planned from the goal pose of the one before;
+    navigate.json holds the first leg as for one goal and every leg in ``legs``."""
+    from capnav.planning.on_map import navigate_on_map, write_outputs
+
+    navs = []
+    stopped = ""
+    for k, goal in enumerate(goals):
+        nav = navigate_on_map(cmap, retriever, goal, start, through_unknown=through_unknown)
+        navs.append(nav)
+        q = nav.query
+        con.print(f"[bold]goal {k + 1} of {len(goals)}[/]: {goal.text}", highlight=False)
+        con.print(f"chosen: {q.chosen.id if q.chosen else '-'} {q.chosen.caption if q.chosen else ''}", highlight=False)
+        con.print(f"[{'green' if nav.ok else 'red'}]{'planned' if nav.ok else 'no plan'}[/]: {nav.reason}",
+                  highlight=False)
+        if not nav.ok or nav.goal is None:
+            if k + 1 < len(goals):
+                stopped = _stopped(k, len(goals), goal.text, "has no plan")
+            break
+        start = (float(nav.goal.xy[0]), float(nav.goal.xy[1]), float(nav.goal.yaw))
+    files = [write_outputs(nav, cmap, out, "navigate" if k == 0 else f"navigate_leg{k + 1}")
+             for k, nav in enumerate(navs)]
+    all_ok = len(navs) == len(goals) and all(n.ok for n in navs)
+    _add_legs(files[0]["json"], [n.to_dict() for n in navs], len(goals), stopped, all_ok)
+    con.print("\n".join(str(f[k]) for f in files for k in ("json", "png")), highlight=False)
+    con.print("\n".join(str(files[0][k]) for k in ("yaml", "pgm")), highlight=False)
+    if stopped:
+        con.print(f"[red]stopped[/]: {stopped}", highlight=False)
+    if not all_ok:
+        raise typer.Exit(1)
 
 
 def _plan_only(con: Console, cmap: CapNavMap, retriever: Retriever, instruction: str,

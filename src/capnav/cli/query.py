@@ -1,4 +1,6 @@
-"""``capnav query MAP "instruction" [--robot X,Y] [--json]``: which object, why, and the runners-up."""
+"""``capnav query MAP "instruction" [--robot X,Y] [--json]``: which object, why, and the runners-up;
+for a request of several goals ("the fridge, then the sofa") every goal in turn, stopping at the
+first that is not found."""
 
 from __future__ import annotations
 
@@ -53,7 +55,7 @@ def register(app: typer.Typer) -> None:
             pending = pool.submit(create_embedder, "minilm" if embedder == "auto" else embedder, **kw)
             from capnav.io.mapfile import load_map
             from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
-            from capnav.retrieval.result import QueryResult
+            from capnav.retrieval.sequence import query_goals
 
             cmap = load_map(map_path, voxels=False)  # retrieval reads objects and occupancy only
             if embedder == "auto":
@@ -71,17 +73,22 @@ def register(app: typer.Typer) -> None:
 
             xy, robot_note = place_robot(cmap.occupancy, xy, "--robot")
         cfg = RetrievalConfig(use_verifier=verifier != "none", use_attribute_heuristic=heuristic)
-        res: QueryResult = Retriever(cmap, emb, create_verifier(verifier), cfg).query(instruction, robot_xy=xy)
+        seq = query_goals(Retriever(cmap, emb, create_verifier(verifier), cfg), instruction, robot_xy=xy)
         if as_json:
-            typer.echo(json.dumps(res.to_dict() | ({"robot_note": robot_note} if robot_note else {}), indent=2))
+            typer.echo(json.dumps(seq.to_dict() | ({"robot_note": robot_note} if robot_note else {}), indent=2))
         else:
             if robot_note:
                 typer.echo(f"note: {robot_note}", err=True)
-            _print(res)
+            for k, res in enumerate(seq.results):
+                if len(seq.goals) > 1:
+                    typer.echo(f"goal {k + 1} of {len(seq.goals)}: {seq.goals[k]}")
+                _print(res)
+            if seq.stopped:
+                typer.echo(f"stopped: {seq.stopped}")
         # Answered "not found": exit code 1, as `capnav navigate` when not reached. With --json the
         # answer is in the payload ("found": false) and a printed answer exits 0, so that scripts
         # that read JSON (and treat a non-zero exit as a failure to answer) see a refusal as one.
-        if res.chosen is None and not as_json:
+        if not seq.found and not as_json:
             raise typer.Exit(1)
 
 

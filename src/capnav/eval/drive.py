@@ -22,6 +22,7 @@ from capnav.planning.sight import map_columns, object_heights
 
 if TYPE_CHECKING:
     from capnav.mapping.cmap import CapNavMap
+    from capnav.retrieval.query import ParsedQuery
     from capnav.retrieval.result import QueryResult
     from capnav.retrieval.retriever import Retriever
     from capnav.sim.simulator import Simulator
@@ -92,14 +93,14 @@ def planning_occupancy(cmap: CapNavMap, sim: Simulator, kind: str) -> OccupancyG
     raise InputError(f"occupancy must be one of {', '.join(OCCUPANCY_KINDS)}, got {kind!r}")
 
 
-def run_instruction(cmap: CapNavMap, sim: Simulator, retriever: Retriever, instruction: str,
+def run_instruction(cmap: CapNavMap, sim: Simulator, retriever: Retriever, instruction: str | ParsedQuery,
                     start: tuple[float, float, float] | None = None, occupancy: str = "mapped",
                     config: PlannerConfig | None = None, out_dir: str | Path | None = None,
                     stem: str = "navigate", agent: Any | None = None) -> InstructionOutcome:
     """Retrieve, plan, execute; with ``out_dir`` write ``<stem>.png`` and ``<stem>.json``.
 
     Give either ``start`` (a new agent is spawned there) or a live ``agent`` (it goes on from where
-    it stands, as in a chain of instructions).
+    it stands, as in a chain of instructions). ``instruction`` may be one goal already parsed.
     """
     cfg = config or PlannerConfig()
     occ = planning_occupancy(cmap, sim, occupancy)
@@ -115,15 +116,16 @@ def run_instruction(cmap: CapNavMap, sim: Simulator, retriever: Retriever, instr
     if query.found and query.chosen is not None:
         nav = navigate_to(agent, occ, query.chosen.footprint, cfg, z_range=object_heights(query.chosen),
                           columns=map_columns(cmap))
-    out = InstructionOutcome(instruction, query, nav, start, occupancy)
+    text = instruction if isinstance(instruction, str) else instruction.text
+    out = InstructionOutcome(text, query, nav, start, occupancy)
     if out_dir is not None:
         from capnav.viz.topdown import short_label, write_navigation
 
         chosen = query.chosen
         if nav is None:
-            title = f'"{instruction}": no object chosen ({query.reason})'
+            title = f'"{text}": no object chosen ({query.reason})'
         else:
-            title = (f'"{instruction}" -> {short_label(chosen) if chosen else "?"}: '
+            title = (f'"{text}" -> {short_label(chosen) if chosen else "?"}: '
                      f"{'reached' if nav.reached else 'NOT reached'}, {nav.distance_to_object:.2f} m from it, "
                      f"path {nav.path_length:.1f} m, {nav.replans} replans")
         out.png, out.json = write_navigation(

@@ -27,6 +27,7 @@ from capnav.planning.sight import map_columns, object_heights
 
 if TYPE_CHECKING:
     from capnav.mapping.cmap import CameraTrajectory, CapNavMap
+    from capnav.retrieval.query import ParsedQuery
     from capnav.retrieval.result import QueryResult
     from capnav.retrieval.retriever import Retriever
 
@@ -129,7 +130,7 @@ class MapNavigation:
                 "retrieval": self.query.to_dict()}
 
 
-def navigate_on_map(cmap: CapNavMap, retriever: Retriever, instruction: str,
+def navigate_on_map(cmap: CapNavMap, retriever: Retriever, instruction: str | ParsedQuery,
                     start: tuple[float, float, float] | None = None, config: PlannerConfig | None = None,
                     path_free_radius: float = PATH_FREE_RADIUS, through_unknown: bool = False) -> MapNavigation:
     """Retrieve the described object, choose a goal pose within reach of it, plan A* to it.
@@ -151,7 +152,8 @@ def navigate_on_map(cmap: CapNavMap, retriever: Retriever, instruction: str,
     cm = build_costmap(occ, cfg, map_columns(cmap))
     locate_start(cm, xy, cfg)  # a start off the map or in an obstacle is the user's error: raise now
     query = retriever.query(instruction, robot_xy=xy)
-    out = MapNavigation(instruction, query, start, source, occ, notes=notes, reach=cfg.reach,
+    text = instruction if isinstance(instruction, str) else instruction.text
+    out = MapNavigation(text, query, start, source, occ, notes=notes, reach=cfg.reach,
                         through_unknown=through_unknown)
     if not query.found or query.chosen is None:
         out.reason = f"no object chosen: {query.reason}"

@@ -128,7 +128,7 @@ class Retriever:
         e_q = self.embedder.embed([q.text])[0]
         t1 = time.perf_counter()
         s = cosine_scores(self.E, e_q)
-        notes: list[str] = []
+        notes: list[str] = list(q.notes)  # what the reading of the instruction could not use
         rk = self._order(q, s, robot_xy, notes)
         order, mode, predicate = rk.order, rk.mode, rk.predicate
         t2 = time.perf_counter()

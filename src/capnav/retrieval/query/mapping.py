@@ -1,0 +1,350 @@
+"""The mapping of a goal's words onto ``ParsedQuery``: the target category (with the other
+categories it may denote), colour / shape / size / material words, a spatial predicate (closest /
+farthest to the robot or to a landmark, biggest / smallest, next to / near / in front of Y, "the
+second closest"), a room ("in the kitchen", "the kitchen stool"), what the target must not be
+("not the white one") and, for requests by purpose ("somewhere to sit"), the categories that serve
+it. The phrase patterns here read one goal whose words the parse (``parse.py``) has already
+chosen; whatever they do not understand still reaches the embedding similarity."""
+
+from __future__ import annotations
+
+import re
+from typing import TYPE_CHECKING
+
+from capnav.language.colors import ALIASES, LEXICON
+from capnav.language.context import ROOM_SYNONYMS
+from capnav.language.purpose import find_activity, match_purpose, purpose_categories
+from capnav.retrieval.query.model import BETWEEN, ROOM_WITH, ParsedQuery
+from capnav.retrieval.query.parse import GoalParse, describe
+from capnav.retrieval.query.tokens import (
+    _COMMON_ADJECTIVES,
+    _FILLER,
+    _GROWTH,
+    _GROWTH_TOKENS,
+    _LEX,
+    _MATERIALS,
+    _ORDINALS,
+    _PROXIMITY,
+    _RELATIONS,
+    _SHAPES,
+    _SIZE_TOKENS,
+    _SUPERLATIVE,
+    _colors,
+    _find_category,
+    _fix_keyword_typos,
+    _form_follows,
+    _other_object,
+    _room_before,
+    _size_word,
+    validate_instruction,
+)
+
+if TYPE_CHECKING:
+    from capnav.language.embedder import TextEmbedder
+
+#: "not the white one", "the one that isn't grey", "other than the red one", "except the ...".
+_NEGATION = re.compile(r"(?:\b(?:that|which|who)\s+)?(?:\bis\s+not\b|\bisn't\b|\bisnt\b|\bnot\b|\bother\s+than\b"
+                       r"|\bexcept(?:\s+for)?\b|\bapart\s+from\b|\brather\s+than\b|\binstead\s+of\b)"
+                       r"\s+(?P<neg>[^,;]+?)(?=\s*(?:[,;]|\bbut\b|\bthe\s+other\b|$))")
+#: The robot itself as the reference of closest / farthest.
+_SELF = re.compile(r"^(?:me|you|us|here|yourself|the robot|where i am|where you are|my position|"
+                   r"your position)\b")
+_PROX_WORDS = {"closest": "closest", "nearest": "closest", "farthest": "farthest", "furthest": "farthest",
+               "most distant": "farthest"}
+
+
+
+
+
+def _landmark_proximity(q: ParsedQuery, head: str) -> str:
+    """"the chair closest to the kitchen table", "the plant nearest the bathtub", "the armchair
+    farthest from the lamp": an anchor with closest / farthest measured from it. Returns ``head``
+    without the landmark phrase."""
+    words = "|".join(sorted(_PROX_WORDS, key=len, reverse=True))
+    m = re.search(rf"\b(?P<p>{words})\b(?P<mid>(?:\s+\S+)*?)\s*(?:\b(?:to|from|of)\s+|\s+)"
+                  rf"(?:the\s+|a\s+|an\s+|my\s+|our\s+)(?P<anchor>.+)$", head)
+    if not m or _SELF.match(m.group("anchor")):
+        return head
+    anchor_words = m.group("anchor").split()
+    cat, span, _ = _find_category(anchor_words)
+    if cat is None or span is None:
+        return head
+    q.proximity = _PROX_WORDS[m.group("p")]
+    q.proximity_to_anchor = True
+    q.anchor_category = cat
+    q.anchor_phrase = " ".join(anchor_words[: span[1]])
+    return (head[: m.start()] + " " + m.group("mid") + " " + " ".join(anchor_words[span[1]:])).strip()
+
+
+#: Verbs of a landmark clause ("the desk the pink chair is pulled up to", "the table that the lamp
+#: stands beside"): the clause's subject is the landmark, not a description of the target.
+_CLAUSE_VERB = re.compile(r"\b(?:is|are|was|were|sits|sit|stands|stand|rests|lies|has\s+been)\b")
+
+
+_ARTICLE = r"(?:the\s+|a\s+|an\s+|my\s+|our\s+|your\s+)?"
+_ROOM_ALT = "|".join(re.escape(r) for r in sorted(ROOM_SYNONYMS, key=len, reverse=True))
+
+
+def _landmark(words: list[str]) -> tuple[str, str, list[str]] | None:
+    """(category, phrase up to its noun, the words after it) of a landmark phrase, else None."""
+    cat, span, _ = _find_category(words)
+    if cat is None or span is None:
+        return None
+    return cat, " ".join(words[: span[1]]), words[span[1]:]
+
+
+def _room_with(q: ParsedQuery, head: str) -> str:
+    """"in the room with the pink dresser", "in the bedroom that has the yellow bed": the target
+    stands in the landmark's room (``ROOM_WITH``); a named room type is kept as the room too.
+    Returns ``head`` without the clause."""
+    m = re.search(rf"\b(?:in|inside|within)\s+{_ARTICLE}(?P<room>{_ROOM_ALT}|room)\s+(?:with|that\s+has|which\s+has"
+                  rf"|where\s+there\s+is|containing)\s+{_ARTICLE}(?P<anchor>.+)$", head)
+    if not m:
+        return head
+    found = _landmark(m.group("anchor").split())
+    if found is None:
+        return head
+    q.relation, q.anchor_category, q.anchor_phrase = ROOM_WITH, found[0], found[1]
+    if m.group("room") != "room":
+        q.room = ROOM_SYNONYMS[m.group("room")]
+    return " ".join([head[: m.start()], *found[2]]).strip()
+
+
+#: A clause of its own inside a purpose request: "... while I watch telly", "... when we eat".
+_CONTEXT_CLAUSE = re.compile(r"\b(?:while|whilst|when|as|and)\s+(?:i|we|you)\s+(?:(?:can|could|am|are|'m)\s+)?"
+                             r"(?P<ctx>.+)$")
+
+
+def _purpose_context(q: ParsedQuery, head: str) -> str:
+    """A purpose request with a clause of its own that names an object ("somewhere to put my
+    coffee down while I watch telly"): the object is the setting, not the target; the target is
+    looked for in the room with it (``ROOM_WITH``). Returns ``head`` without the clause."""
+    if find_activity(head) is None:
+        return head
+    m = _CONTEXT_CLAUSE.search(head)
+    if m is None or find_activity(head[: m.start()]) is None:
+        return head
+    words = m.group("ctx").split()
+    cat, span, _ = _find_category(words)
+    if cat is None or span is None:
+        return head
+    q.relation, q.anchor_category, q.anchor_phrase = ROOM_WITH, cat, " ".join(words[span[0]:span[1]])
+    return head[: m.start()].strip()
+
+
+def _between(q: ParsedQuery, head: str) -> str:
+    """"the table between the green sofa and the purple armchair": two landmarks, each with its
+    own words. Returns ``head`` without them."""
+    m = re.search(rf"\b(?:in\s+)?between\s+{_ARTICLE}(?P<a>.+?)\s+and\s+{_ARTICLE}(?P<b>.+)$", head)
+    if not m or m.start() == 0:
+        return head
+    first, second = _landmark(m.group("a").split()), _landmark(m.group("b").split())
+    if first is None or second is None or first[2]:
+        return head
+    q.relation = BETWEEN
+    q.anchor_category, q.anchor_phrase = first[0], first[1]
+    q.anchor2_category, q.anchor2_phrase = second[0], second[1]
+    return " ".join([head[: m.start()], *second[2]]).strip()
+
+
+def _clause_landmark(q: ParsedQuery, head: str) -> str:
+    """"the desk the pink chair is pulled up to", "the table that the green lamp stands beside":
+    a second noun phrase after the target, followed by a verb, is a landmark next to the target;
+    its words (colours, sizes) are the landmark's. Returns ``head`` without the clause."""
+    words = head.split()
+    cat, span, _ = _find_category(words)
+    if cat is None or span is None:
+        return head
+    k = span[1]
+    if k < len(words) and words[k] in ("that", "which", "where"):
+        k += 1
+    if k >= len(words) or words[k] not in ("the", "a", "an", "my", "our"):
+        return head
+    rest = " ".join(words[k + 1:])
+    m = _CLAUSE_VERB.search(rest)
+    if m is None or m.start() == 0:
+        return head
+    anchor_words = rest[: m.start()].split()
+    acat, aspan, _ = _find_category(anchor_words)
+    if acat is None or aspan is None or aspan[1] != len(anchor_words):
+        return head
+    q.relation = "next to"
+    q.anchor_category = acat
+    q.anchor_phrase = " ".join(anchor_words)
+    return " ".join(words[: span[1]])
+
+
+def _split_alternatives(words: list[str]) -> list[list[str]]:
+    """"purple or orange", "red nor blue", "the white or the grey one": one negated phrase per
+    alternative, so each is excluded on its own (a phrase is excluded only when all of it fits)."""
+    parts: list[list[str]] = [[]]
+    for w in words:
+        if w in ("or", "nor"):
+            parts.append([])
+        else:
+            parts[-1].append(w)
+    return [p for p in parts if p]
+
+
+def _negations(q: ParsedQuery, head: str) -> str:
+    """Fill ``q.negations`` with what the target must not be, as short phrases a parse of their own
+    reads ("white", "in the bedroom"); returns ``head`` without them. The negated phrase's category
+    still names the target ("not the white washer, the other one")."""
+    out = head
+    for m in list(_NEGATION.finditer(head))[::-1]:
+        words = m.group("neg").split()
+        cat, span, _ = _find_category(words)
+        if cat is not None and span is not None:
+            out = out[: m.start()] + " " + " ".join(words[span[0]:span[1]]) + " " + out[m.end():]
+            words = words[:span[0]] + words[span[1]:]
+        else:
+            out = out[: m.start()] + " " + out[m.end():]
+        for part in _split_alternatives(words)[::-1]:
+            while part and part[0] in ("the", "a", "an", "one", "other", "that", "which", "is", "are", "be"):
+                part = part[1:]
+            part = [w for w in part if w not in ("one", "ones", "other")]
+            if part:
+                q.negations.append(" ".join(part))
+    out = re.sub(r"\bthe\s+other\s+(?:one|of\s+the\s+two)\b", " ", out)
+    return " ".join(out.split())
+
+
+def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
+    """Read ``text``. With ``embedder`` (the retriever's), a request by purpose ("somewhere to
+    sit") is mapped to categories through the lexicon's glosses; without one it keeps ``purpose``
+    and no category."""
+    t = validate_instruction(text)
+    low = t.lower()
+    norm = re.sub(r"[^a-z0-9\-' ]+", " ", low)
+    norm = re.sub(r"\b(\w+)n't\b", r"\1 not", norm.replace("isn't", "is not").replace("isnt", "is not"))
+    norm = " ".join(_fix_keyword_typos(norm.replace("'s", "").split()))
+    q = ParsedQuery(text=t)
+    head = _negations(q, norm)
+    # "somewhere to put my coffee down while I watch telly": the telly is where, not what.
+    head = _purpose_context(q, head)
+    # "the bed in the room with the pink dresser", "the wardrobe in the bedroom with the yellow bed".
+    head = _room_with(q, head)
+    # Room: "in the kitchen", "in the living room".
+    for phrase in sorted(ROOM_SYNONYMS, key=len, reverse=True):
+        if phrase not in head:  # cheap test first: a one-shot query compiles only the patterns it needs
+            continue
+        # Not when the room word modifies an object noun ("at the end of the kitchen counter").
+        pat = rf"\b(?:in|inside|within|from|of)\s+(?:the\s+|my\s+|our\s+)?{re.escape(phrase)}\b"
+        m = next((m for m in re.finditer(pat, head) if not _form_follows(head, m.end())), None)
+        if m:
+            q.room = ROOM_SYNONYMS[phrase]
+            head = (head[:m.start()] + " " + head[m.end():]).strip()
+            break
+    # Ordinal: "the second closest", "the 3rd biggest".
+    m = re.search(r"\b(first|second|third|fourth|fifth|1st|2nd|3rd|4th|5th)\s+(?=(?:closest|nearest|farthest"
+                  r"|furthest|most distant|biggest|largest|smallest|tiniest|tallest|widest|littlest|narrowest)\b)",
+                  head)
+    if m:
+        q.ordinal = _ORDINALS[m.group(1)]
+        head = (head[:m.start()] + head[m.end():]).strip()
+    # Closest / farthest to a landmark, before relations ("closest to the table" is no "close to").
+    head = _landmark_proximity(q, head)
+    # Proximity to the robot (checked before relations so that "closest to me" is not a relation).
+    if q.proximity is None:
+        for phrase in sorted(_PROXIMITY, key=len, reverse=True):
+            if phrase in head and re.search(rf"\b{phrase}\b", head):
+                q.proximity = _PROXIMITY[phrase]
+                head = re.sub(rf"\b{phrase}\b", " ", head)
+                break
+        head = re.sub(r"\b(?:to|from)\s+(?:me|you|us|here|the robot)\b|\baway\b", " ", head) \
+            if q.proximity else head
+    # A landmark clause: "the desk the pink chair is pulled up to".
+    if q.anchor_category is None:
+        head = _clause_landmark(q, head)
+    # "the table between the sofa and the armchair": two landmarks.
+    if q.anchor_category is None:
+        head = _between(q, head)
+    # Relation: "<target> next to the <anchor>".
+    if q.anchor_category is None:
+        for rel in _RELATIONS:
+            m = re.search(rf"\b{rel}\s+(?:the\s+|a\s+|an\s+|my\s+)?(.+)$", head) if rel in head else None
+            if m and m.start() > 0:
+                anchor_words = m.group(1).split()
+                cat, _, _ = _find_category(anchor_words)
+                if cat is not None:
+                    q.relation = "next to" if rel in ("besides", "beside", "by", "close to", "alongside") else rel
+                    q.anchor_category = cat
+                    q.anchor_phrase = m.group(1)
+                    head = head[:m.start()]
+                    break
+    words = [w for w in re.split(r"\s+", head.strip()) if w]
+    for phrase in sorted(_SUPERLATIVE, key=len, reverse=True):
+        if phrase in head and re.search(rf"\b{phrase}\b", head):
+            q.superlative = _SUPERLATIVE[phrase]
+            break
+    q.size_word = _size_word(words)
+    q.colors = _colors(words)
+    if len(q.colors) > 1 and "terracotta" in q.colors:  # "a yellow terracotta pot": a material here
+        q.colors.remove("terracotta")
+    q.shapes = list(dict.fromkeys(_SHAPES[w] for w in words if w in _SHAPES))
+    if "l-shaped" in head or "l shaped" in head:
+        q.shapes = list(dict.fromkeys([*q.shapes, "L-shaped"]))
+    q.materials = [w for w in words if w in _MATERIALS]
+    cat, span, fuzzy = _find_category(words)
+    other = _other_object(words, span)
+    if other is not None:
+        # "pool table", "power plant": WordNet names another object ending in a category word.
+        cat, span = None, None
+    q.category = cat
+    if cat == "plant":
+        # "the cactus", "the prickly plant": the growth form the word implies, checked against the points.
+        grams = {" ".join(words[i:i + n]) for n in (1, 2, 3) for i in range(len(words) - n + 1)}
+        q.shapes = list(dict.fromkeys([*q.shapes, *sorted({_GROWTH[g] for g in grams if g in _GROWTH})]))
+    known = (set(_FILLER) | set(LEXICON) | set(ALIASES) | set(_SHAPES) | _SIZE_TOKENS | set(_SUPERLATIVE)
+             | _MATERIALS | _COMMON_ADJECTIVES | {w for c in q.colors for w in c.split()}
+             | (_GROWTH_TOKENS if cat == "plant" else set())
+             | {w for w in words if re.fullmatch(r"[a-z]+-colou?red", w)})
+    if cat is not None and span is not None:
+        form = " ".join(words[span[0]:span[1]])
+        q.category_alternatives = _LEX.category_alternatives(cat, None if fuzzy else form)
+        if q.room is None:
+            room, start = _room_before(words, span[0])
+            if room is not None:
+                q.room = room
+                words = words[:start] + words[span[0]:]
+                span = (start, start + span[1] - span[0])
+    rest = [w for k, w in enumerate(words) if (span is None or not span[0] <= k < span[1]) and w not in known]
+    if cat is None:
+        q.unknown_words = rest
+        activity = find_activity(head) if other is None else None
+        if activity is not None:
+            q.purpose = activity
+            if embedder is not None:
+                # The retriever embeds the instruction next: one batch for both.
+                best, alts = purpose_categories(match_purpose(activity, embedder, along=(q.text,)))
+                if best is not None:
+                    # The lexicon's relatives of each category that serves (a stool beside a chair),
+                    # weighted below it: a room or a landmark can then choose among them.
+                    for c, w in [(best, 1.0), *alts.items()]:
+                        for other, w2 in _LEX.category_alternatives(c).items():
+                            if other != best:
+                                alts[other] = max(alts.get(other, 0.0), round(w * w2, 3))
+                    q.category, q.category_alternatives, q.unknown_words = best, alts, []
+    else:
+        q.unknown_words = rest
+    desc = list(dict.fromkeys(w for part in (*q.colors, *q.materials, *q.shapes) for w in part.split()))
+    noun = q.category if q.category is not None else " ".join(rest[-2:]) if rest else ""
+    q.target_phrase = " ".join([*desc, noun]).strip() or norm
+    return q
+
+
+
+def goal_query(g: GoalParse, embedder: TextEmbedder | None = None) -> ParsedQuery:
+    """``ParsedQuery`` of one parsed goal: the mapping reads the words the parse attached to the
+    target (``g.core``); the text embedded for similarity is the same words when the parse
+    dropped any (an idiom's "blue" must not pull a blue object up), else the goal as said."""
+    q = read_goal(g.core, embedder)
+    if not g.dropped:
+        q.text = validate_instruction(g.text)
+    q.parser, q.notes, q.dropped_words = g.parser, [*g.notes, *q.notes], list(g.dropped)
+    q.origin_room = g.origin_room
+    q.side = g.side
+    q.structure = describe(g)
+    if q.origin_room is not None and q.room == q.origin_room:
+        q.room = next((r for role, r in g.rooms if role == "target" and r != q.origin_room), None)
+    return q

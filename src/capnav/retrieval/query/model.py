@@ -1,0 +1,63 @@
+"""What retrieval reads of one goal of an instruction: the target's category and attributes,
+its landmarks with their relations, its room, what it must not be, and how it was read."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+#: Relations whose geometry the retriever measures beyond the gap: "between" two landmarks
+#: (``anchor2_category``), "at the end of" a long object (the ends of its long axis), and
+#: "in the room with" a landmark (its room region).
+BETWEEN = "between"
+END_OF = "at the end of"
+ROOM_WITH = "in the room with"
+
+
+@dataclass
+class ParsedQuery:
+    text: str  # normalised instruction
+    category: str | None = None  # canonical vocabulary category of the target
+    target_phrase: str = ""  # what to look for, in words ("white couch", "piano")
+    colors: list[str] = field(default_factory=list)
+    materials: list[str] = field(default_factory=list)
+    shapes: list[str] = field(default_factory=list)
+    size_word: str | None = None  # "large" / "small"
+    superlative: str | None = None  # "largest" / "smallest"
+    proximity: str | None = None  # "closest" / "farthest"
+    relation: str | None = None  # "next to", ...
+    anchor_category: str | None = None
+    anchor_phrase: str | None = None
+    room: str | None = None
+    unknown_words: list[str] = field(default_factory=list)
+    #: Other categories the target words may denote, with a weight below 1 (a chair request may
+    #: be served by an armchair or a stool, ranked below chairs; a purpose maps to several).
+    category_alternatives: dict[str, float] = field(default_factory=dict)
+    purpose: str | None = None  # the request named a use ("somewhere to sit"), not an object
+    negations: list[str] = field(default_factory=list)  # phrases the target must NOT match ("white")
+    ordinal: int | None = None  # 2 for "the second closest"
+    proximity_to_anchor: bool = False  # "the chair closest to the table": distance to the anchor
+    anchor2_category: str | None = None  # the second landmark of "between the sofa and the armchair"
+    anchor2_phrase: str | None = None
+    #: How the goal was read: "patterns" or the parser's name; notes say what could not be read.
+    parser: str = ""
+    notes: list[str] = field(default_factory=list)
+    #: Words of the instruction the parse did not attach to this goal's target (never attributes).
+    dropped_words: list[str] = field(default_factory=list)
+    origin_room: str | None = None  # the room a route comes from ("coming out of the bathroom")
+    side: str | None = None  # "left" / "right" as seen walking the route into ``room``
+    #: What an ordinal counts from or along ("the second bookshelf from the door"): a phrase.
+    ordinal_from: str | None = None
+    structure: dict[str, object] = field(default_factory=dict)  # the parse of the goal (head, modifiers, ...)
+
+    @property
+    def has_attributes(self) -> bool:
+        return bool(self.colors or self.materials or self.shapes or self.size_word or self.superlative
+                    or self.relation or self.room)
+
+    @property
+    def category_only(self) -> bool:
+        return self.category is not None and not self.has_attributes and not self.unknown_words
+
+    def to_dict(self) -> dict[str, object]:
+        return {k: v for k, v in self.__dict__.items() if v not in (None, [], "", {}, False)}
+

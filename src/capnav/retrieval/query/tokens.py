@@ -1,0 +1,296 @@
+"""Tokens and lexicon look-ups of an instruction: validation (empty, too long, not English),
+every surface form of every category (WordNet's and the vocabulary's, with plurals), typos of
+category names and keywords, colour, size, shape and material words, ordinals.
+
+Language policy: CapNav understands English only. An instruction with two or more words of another
+language (function words of French, Spanish, German, Italian, Portuguese or Dutch that English
+does not use, or words with letters English does not use), or with one and no English function
+word, is refused with one message: "instruction is not in English (...); only English
+instructions are supported". So "la lampe près du canapé" and "la chaise rose" are refused alike;
+one stray word among English ones ("the lamp in the den", "go to the sofa por favor") is read as
+English, the stray word as an unknown word."""
+
+from __future__ import annotations
+
+import difflib
+import re
+import unicodedata
+
+from rapidfuzz import fuzz, process
+
+from capnav.core.categories import CATEGORIES
+from capnav.core.errors import InputError
+from capnav.language.colors import ALIASES, LEXICON, SHADES, canonical_color, color_lab
+from capnav.language.context import ROOM_SYNONYMS
+from capnav.language.lexicon import load_lexicon
+from capnav.retrieval.query.model import END_OF
+
+MAX_CHARS = 300
+MAX_WORDS = 50
+
+_LEX = load_lexicon()
+
+
+def _plural(form: str) -> str:
+    *head, last = form.split()
+    if last.endswith("f"):
+        last = last[:-1] + "ves"
+    elif last.endswith(("s", "x", "ch", "sh")):
+        last += "es"
+    elif last.endswith("y") and last[-2:-1] not in "aeiou":
+        last = last[:-1] + "ies"
+    else:
+        last += "s"
+    return " ".join([*head, last])
+
+
+#: Every surface form of every category: WordNet's (the lexicon) and the vocabulary's own names
+#: and synonyms, with plurals.
+_FORM_MAP: dict[str, str] = {}
+for _f, _c in sorted(_LEX.forms.items()):
+    _FORM_MAP.setdefault(_plural(_f), _c)
+_FORM_MAP.update(_LEX.forms)
+for _cat in CATEGORIES:
+    for _f in (_cat.name, *_cat.synonyms):
+        _FORM_MAP[_f] = _cat.name
+        _FORM_MAP.setdefault(_plural(_f), _cat.name)
+_FORM_WORDS = {w for f in _FORM_MAP for w in f.split()}
+_FORM_LENGTHS = sorted({len(f) for f in _FORM_MAP})
+
+
+def _form_follows(text: str, pos: int) -> bool:
+    """Whether an object noun follows ``text[pos:]`` after white space ("the kitchen| counter").
+    Dictionary look-ups of each form length: one regular expression of all ~2,500 forms took
+    0.1 s to compile in every process."""
+    rest = text[pos:]
+    word = rest.lstrip()
+    if len(word) == len(rest):
+        return False
+    return any(word[:n] in _FORM_MAP and (len(word) == n or not (word[n].isalnum() or word[n] == "_"))
+               for n in _FORM_LENGTHS if n <= len(word))
+
+#: Typos are matched against the vocabulary's own words only (not WordNet's 600 rarer ones).
+_TYPO_FORMS = {f: c.name for c in CATEGORIES for f0 in (c.name, *c.synonyms) for f in (f0, _plural(f0))}
+_MULTI_FORMS = sorted(f for f in _TYPO_FORMS if " " in f)
+_SINGLE_FORMS = sorted({f for f in _TYPO_FORMS if " " not in f and len(f) >= 4})
+_TYPO_WORDS = {w for f in _TYPO_FORMS for w in f.split()}
+#: rapidfuzz ratio (0-100) at which a misspelt multi-word name is read as that name: two letters
+#: wrong in "washing machine" (89.7) pass, a different word ("washing line") does not.
+_MULTI_TYPO_SCORE = 86.0
+
+_PROXIMITY = {"closest": "closest", "nearest": "closest", "near me": "closest", "closest to me": "closest",
+              "farthest": "farthest", "furthest": "farthest", "most distant": "farthest"}
+_SUPERLATIVE = {"biggest": "largest", "largest": "largest", "largest one": "largest", "widest": "largest",
+                "tallest": "largest", "smallest": "smallest", "tiniest": "smallest", "littlest": "smallest",
+                "narrowest": "smallest"}
+_SIZE_WORDS = {"big": "large", "large": "large", "huge": "large", "larger": "large", "bigger": "large",
+               "small": "small", "little": "small", "tiny": "small", "smaller": "small", "compact": "small"}
+#: WordNet's size adjectives and their comparatives ("king-size", "oversized", "tinier"; the lexicon).
+_SIZE_WORDS.update(_LEX.sizes)
+_SIZE_TOKENS = {w for f in _SIZE_WORDS for w in f.split()}
+_SHAPES = {"round": "round", "circular": "round", "l-shaped": "L-shaped", "l shaped": "L-shaped",
+           "corner": "L-shaped", "long": "long", "rectangular": "rectangular", "square": "square",
+           "curved": "curved", "oval": "round",
+           # the growth words the offline captioner says of a plant (capnav.language.form): a bush
+           # is leafy (its points do not tell it from a leafy crown on a stem)
+           "leafy": "leafy", "bushy": "leafy", "slender": "slender"}
+#: Words that name a plant's growth form ("cactus", "succulent", "prickly"; WordNet's, the lexicon)
+#: -> the growth word the captioner measures ("slender").
+_GROWTH = _LEX.growth
+_GROWTH_TOKENS = {w for f in _GROWTH for w in f.split()}
+_RELATIONS = [END_OF, "in front of", "facing", "next to", "close to", "beside", "besides", "near", "by", "behind",
+              "opposite", "across from", "alongside", "against"]
+_MATERIALS = {"wooden", "wood", "leather", "fabric", "velvet", "metal", "glass", "marble", "plastic",
+              "ceramic", "stainless", "steel", "laminate", "cotton", "acrylic", "paper", "terracotta"}
+_FILLER = {"go", "to", "the", "a", "an", "please", "find", "navigate", "take", "me", "walk", "head", "move",
+           "drive", "could", "you", "can", "would", "kindly", "toward", "towards", "over", "there", "that",
+           "one", "of", "is", "which", "i", "want", "need", "get", "bring", "robot", "hey", "and", "with",
+           "its", "it", "in", "on", "at", "room", "thanks", "thank", "up", "let", "us", "lets", "visit",
+           "approach", "reach", "stop", "ok", "okay", "now", "just", "some", "this"}
+_ENGLISH_HINTS = _FILLER | set(_FORM_MAP) | set(LEXICON) | set(ALIASES) | set(_SIZE_WORDS) | set(_SUPERLATIVE) \
+    | {"closest", "nearest", "farthest", "next", "near", "beside", "behind", "front", "kitchen", "bedroom",
+       "bathroom", "living", "office", "where", "show", "locate"}
+#: Letters with diacritics that English words do not carry (a word with one is not English).
+_ENGLISH_LETTERS = set("abcdefghijklmnopqrstuvwxyz")
+
+
+def _foreign_words(text: str) -> list[str]:
+    """Words of another language: function words of French, Spanish, German, Italian, Portuguese
+    or Dutch that are not English (from the lexicon), and words with letters English does not use
+    ("canapé", "weiße") unless the lexicon knows them."""
+    out = []
+    for k, w in enumerate(re.findall(r"[^\W\d_]+(?:'[^\W\d_]+)?", text)):
+        low = w.lower()
+        if low in _LEX.foreign:
+            if k == 0 or not w[0].isupper():  # a capitalised word inside a sentence is a name ("Van")
+                out.append(low)
+        elif not set(low) <= _ENGLISH_LETTERS | {"'"} and low not in _FORM_MAP:
+            out.append(low)
+    return out
+
+
+def validate_instruction(text: object) -> str:
+    """Normalise whitespace; raise ``InputError`` for empty, very long or non-English text."""
+    if not isinstance(text, str):
+        raise InputError(f"instruction must be a string, got {type(text).__name__}")
+    t = " ".join(text.split())
+    if not t:
+        raise InputError("empty instruction: say what to look for, e.g. 'go to the white sofa'")
+    if len(t) > MAX_CHARS or len(t.split()) > MAX_WORDS:
+        raise InputError(f"instruction too long ({len(t)} characters, {len(t.split())} words); "
+                         f"keep it under {MAX_CHARS} characters and {MAX_WORDS} words")
+    letters = [ch for ch in t if ch.isalpha()]
+    if not letters:
+        raise InputError("instruction has no words")
+    non_latin = sum(1 for ch in letters if not unicodedata.name(ch, "").startswith("LATIN"))
+    if non_latin / len(letters) > 0.3:
+        raise InputError("instruction is not in English (non-Latin script); only English instructions are "
+                         "supported")
+    foreign = _foreign_words(t)
+    words = re.findall(r"[^\W\d_]+(?:'[^\W\d_]+)?", t.lower())
+    english = [w for w in words if w in _LEX.english]
+    if len(foreign) >= 2 or (foreign and not english):
+        raise InputError(f"instruction is not in English ({', '.join(repr(w) for w in foreign[:4])} "
+                         f"{'is' if len(foreign) == 1 else 'are'} not English); only English instructions are "
+                         "supported")
+    return t
+
+
+def _find_category(words: list[str]) -> tuple[str | None, tuple[int, int] | None, bool]:
+    """(category, word span, fuzzy) of the first category mention; exact n-grams before typos."""
+    for n in (3, 2):
+        for i in range(len(words) - n + 1):
+            gram = " ".join(words[i:i + n])
+            if gram in _FORM_MAP:
+                return _FORM_MAP[gram], (i, i + n), False
+    # A typo in a multi-word name ("longe chair", "dinning tabel") before the exact single word
+    # inside it ("chair"): rapidfuzz's normalised edit similarity (symmetric, unlike difflib's),
+    # and only when every changed word is no English word of its own ("dining cable" is not a typo).
+    for n in (3, 2):
+        for i in range(len(words) - n + 1):
+            part = words[i:i + n]
+            hit = process.extractOne(" ".join(part), _MULTI_FORMS, scorer=fuzz.ratio, score_cutoff=_MULTI_TYPO_SCORE)
+            if hit is not None and len(hit[0].split()) == n and all(
+                    w == f or (w not in _FORM_WORDS and w not in _LEX.not_typos and w not in _ENGLISH_HINTS)
+                    for w, f in zip(part, hit[0].split(), strict=True)):
+                return _TYPO_FORMS[hit[0]], (i, i + n), True
+    for i in range(len(words)):
+        if words[i] in _FORM_MAP:
+            return _FORM_MAP[words[i]], (i, i + 1), False
+    for i, w in enumerate(words):
+        if len(w) < 4 or w in _FILLER or canonical_color(w) or w in _SHAPES or w in _SIZE_WORDS \
+                or w in _LEX.not_typos:
+            continue
+        near = difflib.get_close_matches(w, _SINGLE_FORMS, n=1, cutoff=0.8)
+        # A word two or more letters short of a name's start is another word, not a typo ("wash").
+        if near and not (near[0].startswith(w) and len(near[0]) - len(w) >= 2):
+            return _TYPO_FORMS[near[0]], (i, i + 1), True
+    return None, None, False
+
+
+_COLOR_NOT_ALONE = {"light", "dark", "pale", "deep", "bright", "soft", "rich", "vivid", "dull", "muted", "dusty",
+                    "faded", "pastel"}
+
+
+def _color_name(phrase: str) -> str | None:
+    """The palette name of a colour phrase when it has one ("gray" -> "grey"), else the phrase
+    itself when it names a colour ("reddish", "pale pink", "dark wooden"), else None."""
+    if phrase in _COLOR_NOT_ALONE or phrase in _FORM_MAP:
+        return None
+    name = canonical_color(phrase)
+    if name is not None:
+        return name
+    return phrase if color_lab(phrase) is not None else None
+
+
+def _colors(words: list[str]) -> list[str]:
+    out: list[str] = []
+    i = 0
+    while i < len(words):
+        for n in (3, 2, 1):
+            if i + n > len(words):
+                continue
+            gram = " ".join(words[i:i + n]).replace("-coloured", "").replace("-colored", "")
+            if n > 1 and gram in _FORM_MAP:
+                continue
+            c = _color_name(gram)
+            if c:
+                out.append(c)
+                i += n
+                break
+        else:
+            i += 1
+    return list(dict.fromkeys(out))
+
+
+#: Words whose typos would hide a predicate or attribute ("bseide" for "beside", "yelow" for "yellow").
+_KEYWORDS = ["beside", "near", "next", "behind", "opposite", "front", "closest", "nearest", "farthest",
+             "furthest", "biggest", "largest", "smallest", "kitchen", "bedroom", "bathroom", "living", "office",
+             *sorted(w for w in (*LEXICON, *SHADES) if " " not in w and len(w) >= 5)]
+_COMMON_ADJECTIVES = {"shaped", "l", "coloured", "colored", "color", "colour", "first", "second",
+                      "third", "fourth", "last", "other", "left", "right", "main", "old", "new", "nice", "same",
+                      "only", "usual", "favourite", "favorite", "pretty", "modern", "classic", "comfy", "comfortable",
+                      *_COLOR_NOT_ALONE}
+
+
+def _ratio(a: str, b: str) -> float:
+    return difflib.SequenceMatcher(None, a, b).ratio()
+
+
+def _fix_keyword_typos(words: list[str]) -> list[str]:
+    out = []
+    for w in words:
+        if len(w) >= 5 and w not in _ENGLISH_HINTS and w not in _FORM_WORDS and w not in _LEX.not_typos:
+            near = difflib.get_close_matches(w, _KEYWORDS, n=1, cutoff=0.8)
+            # Only when no category word is at least as close ("bedsde" is "bedside", not "beside").
+            if near and _ratio(w, near[0]) > max((_ratio(w, f) for f in _TYPO_WORDS), default=0.0):
+                w = near[0]
+        out.append(w)
+    return out
+
+
+_ORDINALS = {"first": 1, "1st": 1, "second": 2, "2nd": 2, "third": 3, "3rd": 3, "fourth": 4, "4th": 4,
+             "fifth": 5, "5th": 5}
+
+
+def _room_before(words: list[str], start: int) -> tuple[str | None, int]:
+    """A room named just before the target noun ("the kitchen stool"): (room, its first word)."""
+    for n in (2, 1):
+        if start - n >= 0:
+            gram = " ".join(words[start - n:start])
+            if gram in ROOM_SYNONYMS:
+                return ROOM_SYNONYMS[gram], start - n
+    return None, start
+
+
+def _size_word(words: list[str]) -> str | None:
+    """"large" / "small" from the first size word ("king size" and "king-size" alike); a size word
+    right after "a" / "an" that ends the sentence is a noun ("I need a wee", "move a little")."""
+    for i in range(len(words)):
+        for n in (2, 1):
+            gram = " ".join(words[i:i + n])
+            if i + n <= len(words) and gram in _SIZE_WORDS:
+                if i + n == len(words) and i > 0 and words[i - 1] in ("a", "an"):
+                    continue
+                return _SIZE_WORDS[gram]
+    return None
+
+
+def _other_object(words: list[str], span: tuple[int, int] | None) -> str | None:
+    """A WordNet compound around the category span that names something else ("pool table")."""
+    if span is None:
+        return None
+    for n in (3, 2):
+        for i in range(max(0, span[1] - n), span[0] + 1):
+            gram = " ".join(words[i:i + n])
+            if i + n >= span[1] and gram in _LEX.other:
+                return gram
+    return None
+
+
+def attribute_word(word: str) -> bool:
+    """Whether the mapping would read ``word`` as an attribute of the target: a colour, shape,
+    size, material or growth word ("blue", "round", "big", "velvet", "prickly")."""
+    w = word.lower()
+    return bool(w in _SHAPES or w in _SIZE_WORDS or w in _SUPERLATIVE or w in _MATERIALS or w in _GROWTH
+                or _color_name(w))
