@@ -52,9 +52,27 @@ def register(app: typer.Typer) -> None:
         instructions: Annotated[Path | None, typer.Option(
             help="run the free-phrasing protocol from this JSONL file of hand-written instructions (seed, "
                  "instruction, robot, kind, accept_ids) instead of generated episodes")] = None,
+        changes: Annotated[str | None, typer.Option(
+            "--changes", metavar="moved=N,removed=N,added=N",
+            help="the change track instead (docs/change.md): map visit 1, update with visit 2 after these "
+                 "changes, score per change class for capnav (updated map), capnav-static, capnav-remap")] = None,
+        per_class: Annotated[int, typer.Option(min=1, help="with --changes: subgoals per change class and "
+                                                           "apartment")] = 8,
     ) -> None:
         """Run every method on the same apartments, maps and episodes; write results.json and report.md."""
         from capnav.core.console import make_console
+
+        if changes is not None:
+            from capnav.eval.change_track import ChangeTrackConfig, run_change_track, table
+            from capnav.sim.changes import ChangeSpec
+
+            check_output_dir(out, "--out")
+            ccfg = ChangeTrackConfig(scenes=scenes, seed=seed, changes=ChangeSpec.parse(changes), per_class=per_class,
+                                     width=width, height=height, noise=noise)
+            on_interrupt(f"the change track stopped; recordings made so far are kept in {out}/scenes")
+            res_c = run_change_track(ccfg, out, progress=progress)
+            make_console().print(table(res_c), markup=False, highlight=False)
+            return
         from capnav.eval.benchmark import run_benchmark
         from capnav.eval.episodes import parse_protocols
         from capnav.eval.method import load_methods

@@ -1,0 +1,201 @@
+"""The benchmark track for change: map visit 1, update with visit 2, navigate in visit 2's home.
+
+Per apartment: both visits are recorded (``capnav sim --visit``), visit 1 is mapped and captioned,
+then three maps answer the same one-subgoal episodes in the visit-2 world:
+
+* ``capnav``: visit 1's map updated with visit 2 (``capnav map --update``, then captioned);
+* ``capnav-static``: visit 1's map as it was;
+* ``capnav-remap``: visit 2 mapped from scratch.
+
+Goals are written from the truth the user holds, per change class (protocol ``description/<class>``):
+``moved`` (described as at visit 2; success = reached at its new place), ``removed`` (described as at
+visit 1; success = "not found"), ``added`` and ``unchanged`` (success = reached). Only the harness
+reads the manifests; the maps see frames. The update's CPU time (detection included) is measured
+beside mapping visit 2 from scratch on the same frames.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from capnav.core.atomic import write_json
+from capnav.core.grid import FREE
+from capnav.eval.episode_runner import run_episode
+from capnav.eval.episodes import Episode, Subgoal
+from capnav.eval.generate import SceneTruth
+from capnav.eval.method import SceneContext, create_method
+from capnav.eval.metrics import SubgoalRecord, summarize_all
+from capnav.sim.changes import ChangeSpec
+
+CLASSES = ("moved", "removed", "added", "unchanged")
+METHODS = ("capnav", "capnav-static", "capnav-remap")
+
+
+@dataclass(frozen=True)
+class ChangeTrackConfig:
+    """``per_class``: subgoals per change class and apartment (objects are described again, from
+    other starts, when a class has fewer objects); camera ``width`` x ``height``."""
+
+    scenes: int = 3
+    seed: int = 0
+    changes: ChangeSpec = field(default_factory=lambda: ChangeSpec(moved=3, removed=2, added=2))
+    per_class: int = 8
+    width: int = 160
+    height: int = 120
+    rooms: int | None = None
+    noise: str = "default"
+
+    def scene_seeds(self) -> list[int]:
+        return [1000 * self.seed + i for i in range(self.scenes)]
+
+
+def _record(scene: int, cfg: ChangeTrackConfig, folder: Path) -> tuple[Path, Path]:
+    from capnav.sim.record import record_dataset
+
+    v1, v2 = folder / "visit1", folder / "visit2"
+    for path, visit in ((v1, 1), (v2, 2)):
+        if not (path / "meta.json").is_file():
+            record_dataset(scene, path, width=cfg.width, height=cfg.height, rooms=cfg.rooms, progress=False,
+                           visit=visit, changes=cfg.changes if visit > 1 else None, change_seed=cfg.seed,
+                           overwrite=path.exists())
+    return v1, v2
+
+
+def _episodes(scene: int, cfg: ChangeTrackConfig, m1: Any, m2: Any, truth: SceneTruth) -> dict[str, list[Episode]]:
+    from capnav.eval.instructions import InstructionGenerator
+
+    rng = np.random.default_rng([cfg.seed, scene, 0xC4A6])
+    gen1, gen2 = InstructionGenerator(m1), InstructionGenerator(m2)
+    changed = {c.id: c.kind for c in m2.changes}
+    pools = {"moved": [i for i, k in changed.items() if k == "moved"],
+             "removed": [i for i, k in changed.items() if k == "removed"],
+             "added": [i for i, k in changed.items() if k == "added"],
+             "unchanged": sorted(o.id for o in m2.objects if o.id not in changed)}
+    out: dict[str, list[Episode]] = {}
+    for cls, pool in pools.items():
+        eps: list[Episode] = []
+        if cls == "unchanged":
+            pool = [pool[int(i)] for i in rng.permutation(len(pool))[: cfg.per_class]]
+        for n in range(cfg.per_class if pool else 0):
+            i = pool[n % len(pool)]
+            start = truth.sample_start(rng)
+            gen = gen1 if cls == "removed" else gen2
+            text, kind = gen.describe(i, None if cls == "removed" else (start.x, start.y), rng)
+            cat = next(o.category for o in (m1 if cls == "removed" else m2).objects if o.id == i)
+            eps.append(Episode(id=f"s{scene}-{cls}-{n}", scene_seed=scene, start=start,
+                               subgoals=[Subgoal(text=text, category=cat, kind=kind,
+                                                 target_ids=[] if cls == "removed" else [i])]))
+        out[cls] = eps
+    return out
+
+
+def run_change_scene(scene: int, cfg: ChangeTrackConfig, out: Path, progress: bool = False) -> dict[str, Any]:
+    """One apartment of the track: records (per subgoal) and the update's cost figures."""
+    from capnav.io.dataset import DatasetReader
+    from capnav.io.mapfile import save_map
+    from capnav.language import create_captioner, create_embedder, describe_map
+    from capnav.mapping import map_dataset
+    from capnav.mapping.update import register_recording, update_map
+    from capnav.perception import create_detector, create_encoder
+    from capnav.sim import Simulator
+    from capnav.sim.config import CameraConfig, LayoutConfig, SimConfig
+    from capnav.sim.manifest import SceneManifest
+    from capnav.sim.sightline import sight_grid
+
+    folder = out / "scenes" / str(scene)
+    v1, v2 = _record(scene, cfg, folder)
+    emb = create_embedder("minilm")
+    cap = create_captioner("offline")
+
+    def detector() -> Any:  # a fresh one per map: the same noise stream for each
+        return create_detector("sim", noise=cfg.noise, seed=cfg.seed)
+
+    enc = create_encoder("label-embedding", embedder=emb)
+    r1, r2 = DatasetReader(v1), DatasetReader(v2)
+    timings: dict[str, float] = {}
+    t = time.process_time()
+    m1 = map_dataset(r1, detector(), enc, progress=progress)
+    timings["map_visit1_cpu_s"] = time.process_time() - t
+    describe_map(m1, r1, cap, emb, progress=progress)
+    save_map(m1, folder / "visit1.capnav")
+    t = time.process_time()
+    reg = register_recording(m1, r2, f"{v2} to visit 1's map", icp=False)  # same world frame in the simulator
+    mu, rep = update_map(m1, r2, detector(), enc, transform=reg.T, progress=progress, registration=reg)
+    timings["update_cpu_s"] = time.process_time() - t
+    t = time.process_time()
+    describe_map(mu, r2, cap, emb, progress=progress)
+    timings["update_caption_cpu_s"] = time.process_time() - t
+    save_map(mu, folder / "updated.capnav")
+    t = time.process_time()
+    mr = map_dataset(r2, detector(), enc, progress=progress)
+    timings["remap_visit2_cpu_s"] = time.process_time() - t
+    t = time.process_time()
+    describe_map(mr, r2, cap, emb, progress=progress)
+    timings["remap_caption_cpu_s"] = time.process_time() - t
+    save_map(mr, folder / "remapped.capnav")
+
+    man1 = SceneManifest.load(v1 / "manifest.json")
+    man2 = SceneManifest.load(v2 / "manifest.json")
+    simcfg = SimConfig(camera=CameraConfig(width=cfg.width, height=cfg.height),
+                       layout=LayoutConfig(rooms=cfg.rooms) if cfg.rooms is not None else LayoutConfig())
+    records: list[SubgoalRecord] = []
+    with Simulator.from_seed(scene, simcfg, visit=2, changes=cfg.changes, change_seed=cfg.seed) as sim:
+        nav = sim.navigable()
+        truth = SceneTruth.from_manifest(sim.manifest, nav.spec, nav.cells == FREE,
+                                         sight=sight_grid(sim.apartment, nav.spec))
+        episodes = _episodes(scene, cfg, man1, man2, truth)
+        for name, cmap, frames in (("capnav", mu, r2), ("capnav-static", m1, r1), ("capnav-remap", mr, r2)):
+            method = create_method("capnav")
+            ctx = SceneContext(scene_seed=scene, seed=cfg.seed, sim=sim, embedder=emb, detector=detector(),
+                               prior_map=cmap, occupancy=cmap.occupancy, frames=frames, workdir=folder / name)
+            for cls, eps in episodes.items():
+                for ep in eps:
+                    for r in run_episode(method, ctx, ep, truth, f"description/{cls}"):
+                        r.method = name
+                        records.append(r)
+                        write_json(out / "logs" / name / cls / f"{ep.id}.json",
+                                   {"episode": ep.model_dump(), "subgoal": r.to_dict()})
+    return {"scene_seed": scene, "records": [r.to_dict() for r in records], "timings": timings,
+            "update": rep.to_dict(), "objects": {"visit1": len(m1.objects), "updated": len(mu.objects),
+                                                 "retired": len(mu.retired), "remapped": len(mr.objects)}}
+
+
+def run_change_track(cfg: ChangeTrackConfig, out: Path, progress: bool = True) -> dict[str, Any]:
+    """Every apartment of the track; writes ``out/results.json`` and returns it."""
+    from capnav.core.progress import track
+
+    scenes = [run_change_scene(s, cfg, out) for s in track(cfg.scene_seeds(), "change track", enabled=progress)]
+    recs = [SubgoalRecord.from_dict(r) for s in scenes for r in s["records"]]
+    summaries = [s.to_dict() for s in summarize_all(recs)]
+    cpu = {k: round(sum(s["timings"][k] for s in scenes), 3) for k in scenes[0]["timings"]} if scenes else {}
+    results = {"track": "change", "changes": str(cfg.changes), "seed": cfg.seed, "scenes": cfg.scene_seeds(),
+               "camera": [cfg.width, cfg.height], "detector": f"sim:{cfg.noise}", "summaries": summaries,
+               "cpu_seconds": cpu, "per_scene": [{k: v for k, v in s.items() if k != "records"} for s in scenes]}
+    write_json(out / "results.json", results)
+    return results
+
+
+def table(results: dict[str, Any]) -> str:
+    """Success per method and change class, as a markdown table, with the CPU figures."""
+    by = {(s["method"], s["protocol"].split("/")[-1]): s for s in results["summaries"]}
+    lines = ["| method | " + " | ".join(CLASSES) + " |", "|---|" + "---|" * len(CLASSES)]
+    for m in METHODS:
+        cells = []
+        for c in CLASSES:
+            s = by.get((m, c))
+            cells.append("-" if s is None else f"{100 * s['independent']:.1f} ({s['subgoals']})")
+        lines.append(f"| {m} | " + " | ".join(cells) + " |")
+    cpu = results.get("cpu_seconds", {})
+    if cpu:
+        lines.append("")
+        lines.append(f"CPU: update {cpu.get('update_cpu_s', math.nan):.1f} s (detection included) vs mapping visit 2 "
+                     f"from scratch {cpu.get('remap_visit2_cpu_s', math.nan):.1f} s; captions after the update "
+                     f"{cpu.get('update_caption_cpu_s', math.nan):.1f} s vs "
+                     f"{cpu.get('remap_caption_cpu_s', math.nan):.1f} s")
+    return "\n".join(lines)
