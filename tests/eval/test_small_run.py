@@ -67,7 +67,8 @@ def test_rerun_from_episode_files_is_identical(run: tuple[Path, object], tmp_pat
 
 def test_phrasing_protocol_from_a_file(run: tuple[Path, object], tmp_path: Path) -> None:
     """Instructions of the shared file format: a present target, one with a robot position, an
-    absent one (success = refusal), and a malformed line that names its line number."""
+    absent one (success = refusal), a request of two goals (``then``: scored at each goal), and a
+    malformed line that names its line number."""
     from capnav.eval.phrasings import load_phrasings
     from capnav.sim import Simulator
 
@@ -77,22 +78,29 @@ def test_phrasing_protocol_from_a_file(run: tuple[Path, object], tmp_path: Path)
     for o in objs:
         counts[o.category] = counts.get(o.category, 0) + 1
     single = next(o for o in objs if counts[o.category] == 1)
+    second = next(o for o in objs if counts[o.category] == 1 and o.category != single.category)
     x, y = float(single.center[0]) + 2.0, float(single.center[1])
     lines = [{"seed": 4000, "instruction": f"go to the {single.category}", "robot": None, "kind": "category",
               "accept_ids": [single.id]},
              {"seed": 4000, "instruction": f"the {single.category} please", "robot": [x, y], "kind": "category",
               "accept_ids": [single.id]},
              {"seed": 4000, "instruction": "take me to the grand piano", "robot": None, "kind": "absent",
-              "accept_ids": []}]
+              "accept_ids": []},
+             {"seed": 4000, "instruction": f"go to the {single.category} and then to the {second.category}",
+              "robot": None, "kind": "two_step", "accept_ids": [single.id], "then": [second.id]}]
     f = tmp_path / "mine.jsonl"
     f.write_text("".join(json.dumps(d) + "\n" for d in lines))
     es = load_phrasings(f)
-    assert [e.start is None for e in es.episodes] == [True, False, True]
+    assert [e.start is None for e in es.episodes] == [True, False, True, True]
+    assert [g.step for g in es.episodes[3].subgoals] == [0, 1] and es.episodes[3].subgoals[1].target_ids == [second.id]
     cfg = EvalConfig(scenes=1, seed=4, methods=("capnav", "random-object"), protocols=("phrasing",),
                      pipeline=CFG.pipeline)
     res = run_benchmark(cfg, tmp_path / "p", workers=1, progress=False, episode_sets={"phrasing": es})
-    recs = {(r.method, r.episode_id): r for r in res.records}
-    assert len(recs) == 6
+    recs = {(r.method, r.episode_id): r for r in res.records if r.index == 0}
+    assert len(res.records) == 10 and len(recs) == 8
+    chain = [r for r in res.records if r.method == "capnav" and r.episode_id == "phrasing-0004"]
+    assert [r.index for r in chain] == [0, 1] and chain[1].target_ids == [second.id]
+    assert chain[1].retrieval_correct, chain[1].reason  # the second goal, heard in the same words
     absent = recs[("capnav", "phrasing-0003")]
     assert absent.success == (not absent.found) and absent.target_ids == []
     assert recs[("capnav", "phrasing-0002")].start_xy == pytest.approx((x, y), abs=1e-6)
@@ -100,6 +108,7 @@ def test_phrasing_protocol_from_a_file(run: tuple[Path, object], tmp_path: Path)
     assert all(e["start"] is not None for e in saved["episodes"])  # drawn starts are kept for reruns
     report = (tmp_path / "p" / "report.md").read_text()
     assert "Free phrasings" in report and "| absent | 1 |" in report
+    assert "Requests of several goals" in report
     bad = tmp_path / "bad.jsonl"
     bad.write_text(json.dumps(lines[0]) + "\n" + '{"seed": 4000, "robot": null}\n')
     p = _cli("--instructions", str(bad), "--out", str(tmp_path / "o"), "--no-progress")

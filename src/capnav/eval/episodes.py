@@ -41,6 +41,9 @@ class Subgoal(BaseModel):
     target_ids: list[int] = Field(description="ground-truth instance ids that count as success; empty when "
                                               "the right answer is 'not found' (phrasing protocol only)")
     kind: str = "category"  # instruction kind: category, attribute, superlative, relation, room, closest, ...
+    #: Which goal of its text this subgoal is: 0 the first; 1 the goal after "then" of a request of
+    #: two, whose subgoals carry the same text (the phrasing protocol's ``then`` lines).
+    step: int = Field(default=0, ge=0)
 
     @field_validator("category")
     @classmethod

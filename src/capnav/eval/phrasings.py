@@ -3,9 +3,12 @@
 One JSON object per line (the format of the shared development set ``phrasings/dev.jsonl``):
 ``seed`` (the apartment, as ``capnav sim --seed``), ``instruction``, ``robot`` (``[x, y]`` or
 null), ``kind`` (free text, reported per kind), ``accept_ids`` (manifest instance ids that count
-as the goal; empty when the right answer is "not found"), ``note`` (ignored). Each line becomes a
-one-subgoal episode judged like the description protocol: the agent must stop within 1 m of an
-accepted instance; for an absent target, success is a refusal. A line without ``robot`` starts
+as the goal; empty when the right answer is "not found"), ``note`` (ignored) and, for a request of
+two goals, ``then`` (the ids that count as its second goal). Each line becomes an episode judged
+like the description protocol: the agent must stop within 1 m of an accepted instance; for an
+absent target, success is a refusal. A ``then`` line is an episode of two subgoals that both
+carry the whole instruction (``step`` 0 and 1): the method hears the request as said and is
+scored at each goal, the second from where the first stopped. A line without ``robot`` starts
 from a seeded navigable pose at least ``min_start_distance`` from its goal.
 """
 
@@ -29,6 +32,7 @@ class PhrasingLine(BaseModel):
     kind: str = "phrasing"
     accept_ids: list[int] = Field(default_factory=list)
     note: str = ""
+    then: list[int] | None = None  # the ids of a second goal ("..., then the sofa")
 
 
 def load_phrasings(path: str | Path, run_seed: int = 0) -> EpisodeSet:
@@ -52,8 +56,11 @@ def load_phrasings(path: str | Path, run_seed: int = 0) -> EpisodeSet:
             where = ".".join(str(x) for x in first["loc"])
             raise DatasetError(f"{p}:{n}: {where or 'line'}: {first['msg']}") from None
         start = None if line.robot is None else StartPose(x=line.robot[0], y=line.robot[1])
-        goal = Subgoal(text=line.instruction, category="", target_ids=sorted(set(line.accept_ids)), kind=line.kind)
-        episodes.append(Episode(id=f"phrasing-{n:04d}", scene_seed=line.seed, start=start, subgoals=[goal]))
+        goals = [Subgoal(text=line.instruction, category="", target_ids=sorted(set(line.accept_ids)), kind=line.kind)]
+        if line.then is not None:
+            goals.append(Subgoal(text=line.instruction, category="", target_ids=sorted(set(line.then)), kind=line.kind,
+                                 step=1))
+        episodes.append(Episode(id=f"phrasing-{n:04d}", scene_seed=line.seed, start=start, subgoals=goals))
     if not episodes:
         raise DatasetError(f"instruction file {p} has no instructions")
     seeds = sorted({e.scene_seed for e in episodes})

@@ -76,6 +76,24 @@ def table2(summaries: Sequence[Summary]) -> list[str]:
     return lines
 
 
+def sequences(records: Sequence[SubgoalRecord], protocol: str = "phrasing") -> list[str]:
+    """Requests of several goals ("the sink, then the bed"): how many had every goal reached, per
+    method (a request counts only when all its goals succeeded). Empty when there are none."""
+    by: dict[tuple[str, str], list[bool]] = {}
+    for r in records:
+        if r.protocol == protocol:
+            by.setdefault((r.method, r.episode_id), []).append(bool(r.success))
+    chains = {k: v for k, v in by.items() if len(v) > 1}
+    if not chains:
+        return []
+    lines = ["", "Requests of several goals, every goal reached:", "", "| Method | Requests | All goals reached |",
+             "|---|---:|---:|"]
+    for m in sorted({m for m, _ in chains}):
+        done = [all(v) for (mm, _), v in chains.items() if mm == m]
+        lines.append(f"| {m} | {len(done)} | {sum(done)} |")
+    return lines
+
+
 def by_kind(records: Sequence[SubgoalRecord], protocol: str = "phrasing") -> list[str]:
     """Success per instruction kind and method (the phrasing protocol's kinds come from its file)."""
     recs = [r for r in records if r.protocol == protocol]
@@ -174,13 +192,14 @@ def render(summaries: Sequence[Summary], config: Mapping[str, Any],
         out += standings(summaries, "description")
     if "phrasing" in protocols:
         out += ["", "## Free phrasings: hand-written instructions (success %)", "",
-                f"Instructions from `{config.get('instructions', 'a file')}`, one subgoal each, judged like the "
+                f"Instructions from `{config.get('instructions', 'a file')}`, one subgoal per goal, judged like the "
                 "description protocol; an absent target succeeds when the method answers 'not found'.", ""]
         out += _single(summaries, "phrasing")  # one subgoal per episode: no chains to count
         out += standings(summaries, "phrasing")
         if records:
             out += ["", "Successes per kind (paper rule, with the strict count):", ""]
             out += by_kind(records, "phrasing")
+            out += sequences(records, "phrasing")
     out += ["", "## Details", ""]
     out += details(summaries)
     if records:
