@@ -87,3 +87,16 @@ def test_what_is_kept_reaches_the_storage_furniture(emb):
     assert best(find_activity("where are my shirts kept"), emb) in {"wardrobe", "dresser"}
     assert best(find_activity("where do the paperbacks go"), emb) == "bookshelf"
     assert best(find_activity("the thing that holds the frozen peas"), emb) == "refrigerator"
+
+
+@pytest.mark.parametrize("text, activity", [
+    ("where can the children eat their lunch", "eat their lunch"),
+    ("I fancy cooking an omelette", "cooking an omelette"),
+    ("where could my guests hang their coats", "hang their coats"),
+])
+def test_an_activity_with_any_subject_or_a_wish(text, activity):
+    assert find_activity(text) == activity
+
+
+def test_where_something_can_be_found_is_no_activity():
+    assert find_activity("where can the remote be found") is None

@@ -50,6 +50,22 @@ def test_a_kind_of_the_named_category_may_stand_in_with_observed_evidence(study)
     assert study.query("the white table").chosen.id == 1
 
 
+def test_a_sibling_category_never_answers_for_one_that_stands_elsewhere(emb):
+    # A chair in the kitchen, the only stool in the living room: "the stool in the kitchen" is
+    # not the chair (a chair is no kind of stool), and the living-room stool is not in the kitchen.
+    r = _retriever(emb, [
+        make_obj(1, "stove", (0.5, 0.5), (0.6, 0.6, 0.9), (30, 30, 32)),
+        make_obj(2, "refrigerator", (2.0, 0.5), (0.7, 0.7, 1.8), (235, 235, 235)),
+        make_obj(3, "chair", (1.2, 1.6), (0.5, 0.5, 0.9), (120, 80, 40)),
+        make_obj(4, "sofa", (7.5, 5.5), (2.0, 0.9, 0.8), (90, 90, 95)),
+        make_obj(5, "stool", (7.5, 4.2), (0.4, 0.4, 0.6), (20, 20, 20)),
+        make_obj(6, "tv", (7.5, 3.0), (1.2, 0.2, 0.7), (10, 10, 10)),
+    ])
+    res = r.query("the stool in the kitchen")
+    assert not res.found or res.chosen.id == 5, res.reason
+    assert res.chosen is None or res.chosen.label != "chair"
+
+
 def test_a_word_outside_the_lexicon_is_never_served_by_a_lookalike_category(study):
     # No bench: neither the sofa (WordNet files settee under bench; the category table does not)
     # nor the bed answers for it.
@@ -110,3 +126,30 @@ def test_labels_of_an_old_coco_map_come_from_its_detector_id():
     assert detector_labels({"detector": "sim:default:seed=0"}) is None
     assert detector_labels({}) is None
     assert np.all([isinstance(x, str) for x in labels])
+
+
+def test_a_negated_material_excludes_the_candidates_whose_pixels_show_it(emb):
+    from capnav.language.surface import Surface
+
+    grainy = make_obj(1, "armchair", (1.0, 1.0), (0.8, 0.8, 0.9), (110, 70, 40))
+    woven = make_obj(2, "armchair", (4.0, 1.0), (0.8, 0.8, 0.9), (110, 70, 40))
+    r = _retriever(emb, [grainy, woven])
+    r.judge._surfaces[1] = Surface("smooth", 1.0, 0.5, 3000, "grainy", 9.0, 4.0)  # leather's mottle
+    r.judge._surfaces[2] = Surface("woven", 1.6, 0.6, 3000, "woven", 6.0, 4.0)  # a weave
+    res = r.query("the armchair that is not leather")
+    assert res.found and res.chosen.id == 2, res.reason
+    assert "excluded" in res.reason
+    res = r.query("the armchair, not the fabric one")
+    assert res.found and res.chosen.id == 1, res.reason
+
+
+def test_a_negated_material_with_no_confirmed_instance_keeps_the_ones_shown_against_it(emb):
+    from capnav.language.surface import Surface
+
+    unseen = make_obj(1, "sofa", (1.0, 1.0), (2.0, 0.9, 0.8), (235, 235, 230))
+    plain = make_obj(2, "sofa", (5.0, 1.0), (2.0, 0.9, 0.8), (235, 235, 230))
+    r = _retriever(emb, [unseen, plain])
+    r.judge._surfaces[1] = Surface(None, float("nan"), 0.0, 0)  # too few pixels: nothing said
+    r.judge._surfaces[2] = Surface("smooth", 0.8, 0.4, 3000, "plain", 1.5, 0.7)  # velvet-like pile
+    res = r.query("the sofa which isn't leather")
+    assert res.found and res.chosen.id == 2, res.reason

@@ -42,8 +42,10 @@ _PURPOSE = [
     re.compile(r"\b(?:somewhere|someplace|some place|anywhere|a place|a spot|a surface|something|a thing)"
                r"(?:\s+\w+)?\s+(?:where\s+)?(?:(?:i|we|you|one)\s+(?:can|could|might|may)|to|for\s+(?:me\s+)?to"
                r"|for|that\s+i\s+can)\s+(?P<act>.+)"),
-    re.compile(r"\bwhere\s+(?:can|could|do|should|might|would|may)\s+(?:i|we|one|you)\s+(?P<act>.+)"),
-    re.compile(r"\b(?:i|we)\s*(?:'d|would)?\s*(?:need|want|like|wanna|have)\s+(?:to\s+)?(?P<act>(?!go\b|find\b|see\b"
+    re.compile(r"\bwhere\s+(?:can|could|do|should|might|would|may)\s+(?:i|we|one|you|(?:the|my|our|your|his|her|"
+               r"their)\s+\w+)\s+(?P<act>(?!be\b|get\b).+)"),
+    re.compile(r"\b(?:i|we)\s*(?:'d|would)?\s*(?:need|want|like|wanna|have|fancy)\s+(?:to\s+)?(?P<act>(?!go\b|find\b"
+               r"|see\b"
                r"|get to\b|visit\b).+)"),
     re.compile(r"\b(?:i'm|i am|we're|we are)\s+(?P<act>(?:tired|sleepy|hungry|thirsty|cold|dirty)\b.*)"),
 ]

@@ -40,19 +40,21 @@ class Category(RankingConstraint):
             pool = np.arange(n)
             weights = np.ones(n)
         st.pool, st.weights = pool, weights
-        if st.named and q.purpose is None and cfg.use_type_filter and len(pool) and not (weights[pool] >= 1.0).any():
-            # No instance of the named category: a stand-in serves only when the named word is its
-            # hypernym in the lexicon (a coffee table is a table; a table is no desk, a sofa no
-            # bed), and then only for a request whose observed attributes or landmark it shows
-            # ("the round wooden table" -> a round coffee table), never a bare name. A purpose
-            # names several categories and is not restricted.
+        if st.named and q.purpose is None and q.category is not None and cfg.use_type_filter and len(pool):
+            # A stand-in serves a named category only when the named word is its hypernym in the
+            # lexicon (a coffee table is a table, an armchair a chair; a table is no desk, a chair
+            # no stool, a sofa no bed). A purpose names several categories and is not restricted.
             kinds = stand_ins(q)
-            others = sorted({r.cats[int(i)] for i in st.pool} - kinds)
-            st.keep(np.array([r.cats[int(i)] in kinds for i in st.pool], dtype=bool))
+            keep = np.array([st.weights[i] >= 1.0 or r.cats[int(i)] in kinds for i in st.pool], dtype=bool)
+            others = sorted({r.cats[int(i)] for i in st.pool[~keep]})
+            st.keep(keep)
             if others:
-                st.notes.append(f"no {q.category or q.target_phrase} in the map; "
-                                f"{', '.join(others)} {'is' if len(others) == 1 else 'are'} not a kind of "
-                                f"{q.category or q.target_phrase} in the lexicon")
+                st.notes.append(f"{', '.join(others)} {'is' if len(others) == 1 else 'are'} not a kind of "
+                                f"{q.category} in the lexicon, so not considered")
+        if st.named and q.purpose is None and cfg.use_type_filter and len(pool) and not (weights[pool] >= 1.0).any():
+            # No instance of the named category: a kind of it serves only a request whose observed
+            # attributes or landmark it shows ("the round wooden table" -> a round coffee table),
+            # never a bare name ("the table" is not said of the only coffee table).
             if q.shapes:
                 st.keep(np.array([all(w.lower() in (r.objects[i].caption or "").lower() for w in q.shapes)
                                   for i in st.pool], dtype=bool))

@@ -77,6 +77,15 @@ class Negation(RankingConstraint):
                 fits &= np.array([all(w.lower() in (r.objects[int(i)].caption or "").lower() for w in nq.shapes)
                                   for i in pool])
                 judged = True
+            if nq.materials:
+                # "the sofa that isn't leather" presumes a leather one: those whose pixels show it
+                # (evidence supported) are excluded; when none shows it but some show a surface
+                # against it, those are the ones that are not, and the unobserved ones go instead.
+                mat = [r.judge.material(nq, r.objects[int(i)])[0] for i in pool]
+                shows = np.array([m is not None and m >= 1.0 for m in mat])
+                against = np.array([m is None for m in mat])
+                fits &= shows if shows.any() or not against.any() else ~against
+                judged = True
             if judged:
                 for i in pool[fits]:
                     out.setdefault(int(i), phrase)
