@@ -28,7 +28,7 @@ from capnav.sim.manifest import ItemInstance, ObjectInstance, SceneManifest
 class SurfaceQualityConfig:
     item_margin: float = 0.03
     absorbed_points: int = 5  # points of the support's object inside the item (above the top)
-    above_top: float = 0.015
+    above_top: float = 0.03  # above the support's top: a laptop's 2 cm keyboard is the top to a depth sensor
 
 
 def relative_size_error(extent: Any, inst: ObjectInstance | ItemInstance) -> float:

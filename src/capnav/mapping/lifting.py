@@ -3,13 +3,15 @@ object's surface points for the persistent memory."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
 
+from capnav.core.categories import BY_NAME
 from capnav.core.frame import Frame
+from capnav.mapping.support import SupportCutConfig, cut_at_support
 from capnav.perception.base import Detection
 
 
@@ -22,7 +24,8 @@ class LiftConfig:
     boundary noise that spills onto the background and mixed-depth edge pixels, but keeps thin
     parts such as lamp poles and chair legs that an erosion would delete), optionally eroded by
     ``erode`` px, and within ``mad_k`` robust sigmas (at least ``min_band`` m) of the median
-    depth; at most ``max_points`` per detection, evenly spaced."""
+    depth; at most ``max_points`` per detection, evenly spaced. ``support`` cuts the mask at the
+    plane the object stands on or that things stand on (``mapping.support``) before any of it."""
 
     window: float = 0.15
     edge_tol: float = 0.05
@@ -30,6 +33,7 @@ class LiftConfig:
     mad_k: float = 4.0
     min_band: float = 0.5
     max_points: int = 400
+    support: SupportCutConfig = field(default_factory=SupportCutConfig)
 
 
 @dataclass
@@ -45,6 +49,7 @@ class LiftedDetection:
     distance: float  # camera centre to x_i^w
     visibility: float  # 1 - fraction of the outline bordering a nearer surface or the image edge
     truncated: bool
+    support: float = 0.0  # m² of surface the mask covers (its 3D support: what its label votes weigh)
 
     @property
     def box(self) -> tuple[float, float, float, float]:
@@ -141,6 +146,9 @@ def lift_detection(frame: Frame, det: Detection, index: int, grid: NDArray[np.in
         mask = det.mask
     depth = np.asarray(frame.depth)[r0:r1, c0:c1]
     K = frame.K
+    # A thing (a label that is no furniture category) keeps what stands above its support; furniture
+    # sheds the things standing on it.
+    mask = cut_at_support(mask, depth, K, frame.T_wc, (r0, c0), det.box, det.label not in BY_NAME, cfg.support)
     vs, us = np.nonzero(mask)
     if vs.size == 0:
         return None
@@ -172,6 +180,7 @@ def lift_detection(frame: Frame, det: Detection, index: int, grid: NDArray[np.in
         band = max(cfg.min_band, cfg.mad_k * 1.4826 * float(np.median(np.abs(pz - med))))
         keep = np.abs(pz - med) <= band
         pv, pu, pz = pv[keep], pu[keep], pz[keep]
+    support = float(np.sum(pz.astype(np.float64) ** 2)) / (K.fx * K.fy)  # before the sampling below
     if pz.size > cfg.max_points:
         sel = np.linspace(0, pz.size - 1, cfg.max_points).astype(np.intp)
         pv, pu, pz = pv[sel], pu[sel], pz[sel]
@@ -184,5 +193,5 @@ def lift_detection(frame: Frame, det: Detection, index: int, grid: NDArray[np.in
         descriptor=indexed_descriptor(mask, grid, table, (r0, c0), (h, w)),
         points=pts, colors=cols, distance=float(np.linalg.norm(pc)),
         visibility=outline_visibility(mask, depth, image_border=(r0 == 0, c0 == 0, r1 == h, c1 == w)),
-        truncated=det.truncated(w, h),
+        truncated=det.truncated(w, h), support=support,
     )

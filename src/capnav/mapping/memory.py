@@ -20,7 +20,8 @@ from capnav.core.categories import BY_NAME, confusable
 from capnav.core.errors import InputError
 from capnav.mapping.lifting import LiftedDetection
 from capnav.mapping.objects import MapObject, Observation
-from capnav.mapping.tracker import Track
+from capnav.mapping.support import stands_on
+from capnav.mapping.tracker import Track, vote_weight
 
 
 @dataclass(frozen=True)
@@ -35,7 +36,8 @@ class MemoryConfig:
     one thing: at least ``same_overlap`` of the smaller one's points lie within ``overlap_radius``
     of the other's (a part inside its whole, or one object mapped twice under two labels by a
     real detector); those merge at export whatever their labels, the label votes summed (> 1
-    turns this off). 0.6 and 0.8 merged two distinct objects of generated apartment 2
+    turns this off), unless the smaller stands on the other (``support.stands_on``: a bowl on a
+    desk). 0.6 and 0.8 merged two distinct objects of generated apartment 2
     (``benchmarks/bench_mapping.py --seeds 2 --quality-only``: recall 96%); 0.95 keeps them apart.
 
     ``recheck``: eq. 12 can hand a track the detection of a same-class neighbour when the right
@@ -192,8 +194,9 @@ class ObjectMemory:
     def _add(self, obj: _ObjectState, det: LiftedDetection, obs: Observation, frame: int) -> None:
         cfg = self.config
         w = float(det.detection.score)
+        support = vote_weight(det)  # votes weigh confidence x m² of surface, not one per box
         for label, v in det.detection.label_votes().items():
-            obj.votes[label] = obj.votes.get(label, 0.0) + v
+            obj.votes[label] = obj.votes.get(label, 0.0) + v * support
         obj.feature = ((obj.feature * obj.feature_weight + det.descriptor * w) / (obj.feature_weight + w)).astype(
             np.float32)
         obj.feature_weight += w
@@ -267,7 +270,9 @@ class ObjectMemory:
         if cfg.same_overlap <= 1.0 and len(small.points) and len(big.points):
             d, _ = cKDTree(big.points).query(small.points, distance_upper_bound=cfg.overlap_radius)
             near = float(np.isfinite(d).mean())
-            if near >= cfg.same_overlap:  # one thing, whatever the labels and however often seen together
+            # One thing, whatever the labels and however often seen together; unless the smaller
+            # stands on the larger (a bowl on a desk is within centimetres of its top everywhere).
+            if near >= cfg.same_overlap and not stands_on(small.points, big.points):
                 return 1.0 + near
         if len(oa.frames & ob.frames) > cfg.max_covisible:
             return 0.0

@@ -45,7 +45,7 @@ class MapObject:
 
     id: int
     label: str  # current category estimate (majority of label votes)
-    label_votes: dict[str, float]  # label -> accumulated detector confidence
+    label_votes: dict[str, float]  # label -> accumulated detector confidence x m² of surface seen
     position: NDArray[np.float64]  # (3,) world centroid (m)
     extent_min: NDArray[np.float64]  # (3,) world axis-aligned box
     extent_max: NDArray[np.float64]  # (3,)

@@ -95,19 +95,27 @@ class Track:
         return self.object_id is not None
 
     def vote(self, class_id: int, label: str, score: float) -> None:
-        """Class ``c_j`` is the score-weighted majority of the track's detections."""
+        """Class ``c_j`` is the weighted majority of the track's detections (``vote_all``)."""
         self.class_votes[class_id] = self.class_votes.get(class_id, 0.0) + float(score)
         self.labels[class_id] = label
         self.class_id = max(self.class_votes, key=lambda c: (self.class_votes[c], -c))
         self.label = self.labels[self.class_id]
 
 
+def vote_weight(d: LiftedDetection) -> float:
+    """What a detection's label vote weighs besides its confidence: its 3D support (m² of surface,
+    ``LiftedDetection.support``), so that the cups standing on a table, each detected as often as
+    the table, do not outvote it. At least 1 cm², so a detection without depth still counts."""
+    return max(float(d.support), 1e-4)
+
+
 def vote_all(t: Track, d: LiftedDetection) -> None:
     """Vote for every label the detection stands for (``Detection.label_votes``: several when
-    overlapping detections of one thing were merged)."""
+    overlapping detections of one thing were merged), each weighted by ``vote_weight``."""
+    w = vote_weight(d)
     for label, score in d.detection.label_votes().items():
         cat = BY_NAME.get(label)
-        t.vote(d.class_id if label == d.detection.label else (cat.id if cat else 0), label, score)
+        t.vote(d.class_id if label == d.detection.label else (cat.id if cat else 0), label, score * w)
 
 
 @dataclass

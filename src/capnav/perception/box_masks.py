@@ -101,7 +101,7 @@ def nearest_depth_mode(depths: NDArray[np.floating], window: float = 0.4, bin_si
 def depth_box_mask(depth: NDArray[np.floating], box: Box, band: float = 0.4, bin_size: float = 0.05,
                    min_mode_frac: float = 0.3, min_valid: int = 4, extent: float = 1.5, gap: float = 0.04,
                    gap_rel: float = 0.02, exclude: NDArray[np.bool_] | None = None,
-                   method: str = "surfaces") -> NDArray[np.bool_]:
+                   method: str = "surfaces", up: NDArray[np.bool_] | None = None) -> NDArray[np.bool_]:
     """The object in ``box``.
 
     ``method="surfaces"`` (default, ``surface_mask``): the box's smooth surfaces minus the
@@ -110,8 +110,10 @@ def depth_box_mask(depth: NDArray[np.floating], box: Box, band: float = 0.4, bin
     pixels within ``band / 2`` of the nearest strong depth mode's median depth, their largest
     8-connected component, grown along smooth depth up to ``extent`` metres behind the mode
     (``grow_smooth``). ``exclude`` (H, W) marks pixels that belong to no object (the floor,
-    ``floor_pixels``). Returns an empty mask when the box holds fewer than ``min_valid`` usable
-    depth pixels.
+    ``floor_pixels``). ``up`` (H, W) marks pixels whose surface faces up (``up_facing_pixels``):
+    where it changes, one surface ends and another begins (a table top and the wall it touches,
+    seen at a slant, meet without a depth jump). Returns an empty mask when the box holds fewer
+    than ``min_valid`` usable depth pixels.
     """
     if method not in MASK_METHODS:
         raise InputError(f"unknown depth mask method {method!r}; available: {', '.join(MASK_METHODS)}")
@@ -122,6 +124,8 @@ def depth_box_mask(depth: NDArray[np.floating], box: Box, band: float = 0.4, bin
         raise InputError(f"depth must be (H, W), got shape {z.shape}")
     if exclude is not None and np.shape(exclude) != z.shape:
         raise InputError(f"exclude mask shape {np.shape(exclude)} != depth shape {z.shape}")
+    if up is not None and np.shape(up) != z.shape:
+        raise InputError(f"up mask shape {np.shape(up)} != depth shape {z.shape}")
     mask = np.zeros(z.shape, dtype=bool)
     c0, r0, c1, r1 = box_pixels(box, (z.shape[0], z.shape[1]))
     crop = z[r0:r1, c0:c1].astype(np.float64)
@@ -132,7 +136,8 @@ def depth_box_mask(depth: NDArray[np.floating], box: Box, band: float = 0.4, bin
     if int(valid.sum()) < max(1, min_valid):
         return mask
     if method == "surfaces":
-        surf = surface_mask(z, (c0, r0, c1, r1), exclude, extent=extent, gap=gap, gap_rel=gap_rel, min_valid=min_valid)
+        surf = surface_mask(z, (c0, r0, c1, r1), exclude, extent=extent, gap=gap, gap_rel=gap_rel, min_valid=min_valid,
+                            up=up)
         if surf is not None:
             return surf
     crop = np.where(valid, crop, 0.0)
@@ -272,16 +277,22 @@ def surface_mask(depth: NDArray[np.floating], box_px: tuple[int, int, int, int],
                  exclude: NDArray[np.bool_] | None = None, extent: float = 1.5, gap: float = 0.04,
                  gap_rel: float = 0.02, ring: float = 0.1, side_frac: float = 0.3, hidden_frac: float = 0.5,
                  min_valid: int = 4, min_share: float = 0.02, front: float = 0.75, kink: float = 0.03,
-                 max_leads: int = 8, fill_tol: float = 0.8) -> NDArray[np.bool_] | None:
+                 max_leads: int = 8, fill_tol: float = 0.8, up: NDArray[np.bool_] | None = None
+                 ) -> NDArray[np.bool_] | None:
     """The object's own surfaces in the pixel window ``box_px`` (x0, y0, x1, y1), or None.
 
     A box from a detector frames one object; what else it catches is background, seen around
     the object or through it (an open chair back, the gap under a table). The window grown by a
     ``ring`` of its size is cut into smooth surfaces at depth jumps (``depth_jumps``, far side
-    only, so a one-pixel chair leg stays whole) and creases (``depth_kinks``); cut pixels rejoin
+    only, so a one-pixel chair leg stays whole), creases (``depth_kinks``) and, given ``up``
+    (``up_facing_pixels``), where a surface stops facing up (``facing_up``: a table top against
+    the wall behind it, which a slanted view shows with neither a jump nor a crease in depth, is
+    never one surface with it); cut pixels rejoin
     the neighbour of nearest depth. For each surface: its pixels in the box, how much of each ring
     side (above, below, left, right of the box) it covers, and the share of its outline (next to
-    anything else, the floor and invalid pixels included) where it is the far side (``hidden``).
+    anything else, the floor and invalid pixels included; given ``up``, next to other surfaces
+    only, so that the wall seen under a table between its legs is hidden although it also
+    borders the floor) where it is the far side (``hidden``).
     A surface covering at least ``side_frac`` of two ring sides runs on past the object (a wall,
     the floor, a far room) and is background. Each of the ``max_leads`` largest surfaces (at
     least ``min_share`` of the box's valid pixels, not mostly hidden) leads a group; the surfaces
@@ -315,7 +326,13 @@ def surface_mask(depth: NDArray[np.floating], box_px: tuple[int, int, int, int],
         return None
     tol = gap + gap_rel * z
     jump = depth_jumps(z, ok, gap, gap_rel, far_only=True) | depth_kinks(z, ok, kink, 0.5 * gap_rel)
-    labels, n = ndimage.label(ok & ~jump)
+    if up is not None:  # up-facing and other pixels never share a surface
+        u = facing_up(np.asarray(up, dtype=bool)[R0:R1, C0:C1], ok)
+        la, na = ndimage.label(ok & ~jump & u)
+        lb, n = ndimage.label(ok & ~jump & ~u)
+        labels, n = np.where(la > 0, la, np.where(lb > 0, lb + na, 0)), na + n
+    else:
+        labels, n = ndimage.label(ok & ~jump)
     if n == 0:
         return None
     labels = _attach(z, labels.astype(np.int64), ok & jump, tol)
@@ -337,9 +354,12 @@ def surface_mask(depth: NDArray[np.floating], box_px: tuple[int, int, int, int],
     for a_l, b_l, a_z, b_z in ((labels[1:], labels[:-1], z[1:], z[:-1]),
                                (labels[:, 1:], labels[:, :-1], z[:, 1:], z[:, :-1])):
         diff = a_l != b_l
-        edge += np.bincount(a_l[diff], minlength=nb) + np.bincount(b_l[diff], minlength=nb)  # whole outline
         pair = diff & (a_l > 0) & (b_l > 0)
         la, lb, za, zb = a_l[pair], b_l[pair], a_z[pair], b_z[pair]
+        if up is None:  # the whole outline, the floor and invalid pixels included
+            edge += np.bincount(a_l[diff], minlength=nb) + np.bincount(b_l[diff], minlength=nb)
+        else:  # only against other surfaces: the wall under a table, between its legs, borders the floor
+            edge += np.bincount(la, minlength=nb) + np.bincount(lb, minlength=nb)
         hid += np.bincount(la, weights=(za > zb).astype(np.float64), minlength=nb)
         hid += np.bincount(lb, weights=(zb > za).astype(np.float64), minlength=nb)
         pairs.append(np.stack([la, lb]))
@@ -370,6 +390,40 @@ def surface_mask(depth: NDArray[np.floating], box_px: tuple[int, int, int, int],
     return mask
 
 
+def up_facing_pixels(depth: NDArray[np.floating], K: Any, T_wc: NDArray[np.floating], step: int = 2,
+                     up_cos: float = 0.85) -> NDArray[np.bool_]:
+    """Pixels whose depth surface faces up or down in the world (z up): table tops, seats, shelves.
+
+    The normal is the cross product of the back-projected neighbours ``step`` px away left/right
+    and above/below; it faces up when ``|n_z| >= up_cos |n|`` (within ~32 degrees). A pixel
+    without four valid neighbours is not up-facing."""
+    d = np.asarray(depth, dtype=np.float64)
+    h, w = d.shape
+    with np.errstate(invalid="ignore"):
+        ok = np.isfinite(d) & (d > 0)
+    z = np.where(ok, d, 0.0)
+    us = np.arange(w, dtype=np.float64)[None, :]
+    vs = np.arange(h, dtype=np.float64)[:, None]
+    T = np.asarray(T_wc, dtype=np.float64)
+    P = np.stack([(us - K.cx) * z / K.fx, (vs - K.cy) * z / K.fy, z], axis=-1) @ T[:3, :3].T
+    s = max(1, int(step))
+    out = np.zeros((h, w), dtype=bool)
+    if h <= 2 * s or w <= 2 * s:
+        return out
+    n = np.cross(P[s:-s, 2 * s:] - P[s:-s, : -2 * s], P[2 * s:, s:-s] - P[: -2 * s, s:-s])
+    norm = np.linalg.norm(n, axis=-1)
+    good = ok[s:-s, 2 * s:] & ok[s:-s, : -2 * s] & ok[2 * s:, s:-s] & ok[: -2 * s, s:-s] & ok[s:-s, s:-s]
+    out[s:-s, s:-s] = good & (norm > 0) & (np.abs(n[..., 2]) >= up_cos * norm)
+    return out
+
+
+def facing_up(up: NDArray[np.bool_], ok: NDArray[np.bool_], speck: int = 1) -> NDArray[np.bool_]:
+    """``up`` without specks of either kind (an opening, then a closing, by ``speck`` px: sensor
+    noise flips single normals), on valid pixels."""
+    u = ndimage.binary_opening(up & ok, iterations=speck)
+    return np.asarray(ndimage.binary_closing(u, iterations=speck) & ok)
+
+
 def floor_pixels(depth: NDArray[np.floating], K: Any, T_wc: NDArray[np.floating], height: float = 0.05
                  ) -> NDArray[np.bool_]:
     """Pixels whose back-projected point lies below ``height`` in the world (floor at z = 0, z up).
@@ -388,6 +442,7 @@ def floor_pixels(depth: NDArray[np.floating], K: Any, T_wc: NDArray[np.floating]
 
 
 def depth_box_masks(depth: NDArray[np.floating], boxes: Sequence[Box], band: float = 0.4,
-                    exclude: NDArray[np.bool_] | None = None, **kw: float) -> list[NDArray[np.bool_]]:
+                    exclude: NDArray[np.bool_] | None = None, up: NDArray[np.bool_] | None = None,
+                    **kw: float) -> list[NDArray[np.bool_]]:
     """``depth_box_mask`` for every box of one frame."""
-    return [depth_box_mask(depth, b, band=band, exclude=exclude, **kw) for b in boxes]  # type: ignore[arg-type]
+    return [depth_box_mask(depth, b, band=band, exclude=exclude, up=up, **kw) for b in boxes]  # type: ignore[arg-type]

@@ -34,7 +34,7 @@ from capnav.core.categories import NAMES, category
 from capnav.core.errors import FrameError, InputError, ModelError, pip_hint
 from capnav.core.frame import Frame
 from capnav.perception.base import DETECTORS, Detection, Detector
-from capnav.perception.box_masks import depth_box_masks, filled_box_mask, floor_pixels
+from capnav.perception.box_masks import depth_box_masks, filled_box_mask, floor_pixels, up_facing_pixels
 from capnav.perception.nms import per_class_nms
 
 MASK_MODES = ("depth", "sam", "box")
@@ -276,7 +276,9 @@ class OwlDetector(Detector):
         elif self.mask_mode == "depth":
             depth = np.asarray(frame.depth)
             floor = None if self.floor_height is None else floor_pixels(depth, frame.K, frame.T_wc, self.floor_height)
-            raw = depth_box_masks(depth, box_list, band=self.depth_band, exclude=floor, extent=self.depth_extent)
+            up = None if floor is None else up_facing_pixels(depth, frame.K, frame.T_wc)  # pose trusted like the floor
+            raw = depth_box_masks(depth, box_list, band=self.depth_band, exclude=floor, extent=self.depth_extent,
+                                  up=up)
         else:
             raw = [filled_box_mask(b, (h, w)) for b in box_list]
         return [m & filled_box_mask(b, (h, w)) for m, b in zip(raw, box_list, strict=True)]
