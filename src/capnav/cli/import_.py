@@ -1,4 +1,4 @@
-"""``capnav import auto|tum|open3d|3dmatch|scannet|rosbag SRC -o DATASET``: bring a recording into a
+"""``capnav import auto|tum|open3d|3dmatch|scannet|stray|rosbag SRC -o DATASET``: bring a recording into a
 ``capnav-rgbd`` folder.
 
 ``auto`` recognises the layout from its files and says which it is. The recording's world frame is
@@ -56,8 +56,8 @@ def _import(reader: Callable[[], Recording], out: Path, up: str, stride: int, ma
 
 
 def register(app: typer.Typer) -> None:
-    imp = typer.Typer(help="Import a recording (TUM RGB-D, Open3D, 3DMatch, ScanNet, ROS1/ROS2 bag) as a "
-                           "capnav-rgbd dataset folder; 'auto' recognises the layout.", no_args_is_help=True)
+    imp = typer.Typer(help="Import a recording (TUM RGB-D, Open3D, 3DMatch, ScanNet, Stray Scanner, ROS1/ROS2 bag) "
+                           "as a capnav-rgbd dataset folder; 'auto' recognises the layout.", no_args_is_help=True)
 
     @imp.command("auto")
     def auto_cmd(
@@ -66,8 +66,8 @@ def register(app: typer.Typer) -> None:
         intrinsics: Intrinsics = None, depth_scale: DepthScale = None, stride: Stride = 1,
         max_frames: MaxFrames = None, up: Up = "auto", overwrite: Overwrite = False, progress: Progress = True,
     ) -> None:
-        """Recognise the layout of SRC (TUM, Open3D, 3DMatch, ScanNet) from its files and import it with that
-        layout's defaults (its depth scale, its intrinsics file)."""
+        """Recognise the layout of SRC (TUM, Open3D, 3DMatch, ScanNet, Stray Scanner) from its files and import it
+        with that layout's defaults (its depth scale, its intrinsics file)."""
         from capnav.io.layouts import open_recording
 
         found: dict[str, str] = {}
@@ -107,6 +107,27 @@ def register(app: typer.Typer) -> None:
         from capnav.io.threedmatch import DEPTH_SCALE, ThreeDMatchReader
 
         _import(lambda: ThreeDMatchReader(src, intrinsics, depth_scale=depth_scale or DEPTH_SCALE),
+                out, up, stride, max_frames, overwrite, progress)
+
+    @imp.command("stray")
+    def stray_cmd(
+        src: Annotated[Path, typer.Argument(help="Stray Scanner capture: rgb.mp4 (or rgb/), depth/, confidence/, "
+                                                 "odometry.csv, camera_matrix.csv")],
+        out: Out,
+        intrinsics: Intrinsics = None, depth_scale: DepthScale = None,
+        min_confidence: int = typer.Option(1, "--min-confidence", min=0, max=2,
+                                           help="drop depth pixels of lower LiDAR confidence (0, 1, 2)"),
+        camera_axes: str = typer.Option("opencv", "--camera-axes", help="opencv (x right, y down, z forward) or "
+                                                                        "opengl (ARKit's y up, z backwards)"),
+        max_width: int = typer.Option(640, "--max-width", min=32, help="write frames at most this wide"),
+        stride: Stride = 1, max_frames: MaxFrames = None, up: Up = "auto", overwrite: Overwrite = False,
+        progress: Progress = True,
+    ) -> None:
+        """Import a Stray Scanner iPhone capture (LiDAR depth upsampled to the colour's view, ARKit poses)."""
+        from capnav.io.stray import DEPTH_SCALE, StrayReader
+
+        _import(lambda: StrayReader(src, intrinsics, depth_scale=depth_scale or DEPTH_SCALE,
+                                    min_confidence=min_confidence, camera_axes=camera_axes, max_width=max_width),
                 out, up, stride, max_frames, overwrite, progress)
 
     @imp.command("scannet")

@@ -35,7 +35,7 @@ class FrameFiles:
     name: str
     source_index: int
     timestamp: float
-    rgb: Path
+    rgb: Path | int  # a file, or a frame of a video
     depth: Path | None  # None: no depth image of this number
     T_wc: NDArray[np.float64] | None
     why_no_pose: str = ""
@@ -127,7 +127,7 @@ class FolderReader:
         if not paired:
             raise InputError(f"{root}: no colour image has a depth image of the same number")
         check_fit(self.depth_K, k_src, [f.depth for f in paired[:5] if f.depth], "the depth image")
-        check_fit(self.colour_K, k_src, [f.rgb for f in paired[:5]], "the colour image")
+        check_fit(self.colour_K, k_src, [f.rgb for f in paired[:5] if isinstance(f.rgb, Path)], "the colour image")
         self.skipped = SkipLog()
         self.frames: list[PlannedFrame] = []
         for f in files:

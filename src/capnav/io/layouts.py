@@ -103,6 +103,8 @@ LAYOUTS: tuple[Layout, ...] = (
            _open("capnav.io.scannet", "ScannetReader")),
     Layout("open3d", "image/ (or color/), depth/, trajectory.log (Open3D / Redwood)", _open3d,
            _open("capnav.io.open3d_log", "Open3dReader")),
+    Layout("stray", "odometry.csv, camera_matrix.csv, depth/, rgb.mp4 or rgb/ (Stray Scanner)", _stray,
+           _open("capnav.io.stray", "StrayReader")),
     Layout("3dmatch", "frame-XXXXXX.color.png|jpg, .depth.png, .pose.txt, camera-intrinsics.txt", _3dmatch,
            _open("capnav.io.threedmatch", "ThreeDMatchReader")),
 )

@@ -62,7 +62,9 @@ class ThreeDMatchReader(FolderReader):
                 if pose.is_file():
                     T, why = rigid_or_reason(read_matrix(pose, 4, 4, "pose"), str(pose))
                 files.append(FrameFiles(name, n, n / fps, p, depth if depth.is_file() else None, T, why))
-        K, k_src = self._intrinsics(intrinsics, root, seqs[0], files[0].rgb)
+        first = files[0].rgb
+        assert isinstance(first, Path)
+        K, k_src = self._intrinsics(intrinsics, root, seqs[0], first)
         super().__init__(root, K, k_src, files, depth_scale,
                          {"sequences": [s.name for s in seqs], "fps": fps}, invalid_depth=65535)
 
