@@ -113,3 +113,39 @@ def test_simplified_segments_are_clear(seed: int) -> None:
         # Either a clear straight segment, or one diagonal grid step of A* past a corner.
         one_step = np.abs(a - b).max() == 1
         assert one_step or line_clear(w, int(a[0]), int(a[1]), int(b[0]), int(b[1]), 1.0)
+
+
+def test_kept_work_arrays_stay_correct_across_searches_and_raised_weights() -> None:
+    """Searches on one grid reuse their arrays (no per-call scan or clearing): 300 searches (the
+    one-byte stamps wrap twice) agree with a fresh grid, and a cell blocked in place between two
+    searches is avoided by the next one."""
+    rng = np.random.default_rng(5)
+    w = random_weights(rng, 40, 50, p_block=0.2, p_heavy=0.2).astype(np.float32)
+    free = np.argwhere(np.isfinite(w))
+    for _ in range(300):
+        a, b = free[rng.choice(len(free), size=2, replace=False)]
+        _, cost = astar(w, tuple(a), tuple(b))
+        _, fresh = astar(w.copy(), tuple(a), tuple(b))
+        assert cost == fresh
+    w = np.ones((20, 20), np.float32)
+    cells, _ = astar(w, (10, 0), (10, 19))
+    assert (cells[:, 0] == 10).all()  # straight along row 10
+    w[3:18, 10] = np.inf  # raised in place, as mark_blocked does
+    cells, cost = astar(w, (10, 0), (10, 19))
+    assert np.isfinite(w[cells[:, 0], cells[:, 1]]).all() and cost > 19.5
+    field, _ = cost_field(w, (10, 0))
+    assert field[10, 19] == pytest.approx(cost) and np.isinf(field[10, 10])
+
+
+def test_threads_search_one_grid_at_once() -> None:
+    """Two threads on one weight grid: one uses the kept arrays, the other fresh ones."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    rng = np.random.default_rng(6)
+    w = random_weights(rng, 60, 60, p_block=0.2, p_heavy=0.2)
+    free = np.argwhere(np.isfinite(w))
+    pairs = [tuple(map(tuple, free[rng.choice(len(free), size=2, replace=False)])) for _ in range(40)]
+    expected = [astar(w.copy(), a, b)[1] for a, b in pairs]
+    with ThreadPoolExecutor(4) as ex:
+        got = list(ex.map(lambda p: astar(w, p[0], p[1])[1], pairs))
+    assert got == expected

@@ -19,7 +19,7 @@ Cell = tuple[int, int]
 
 
 class GridSearch(Protocol):
-    def __call__(self, weights: NDArray[np.float64], start: Cell, goal: Cell) -> tuple[NDArray[np.intp], float]:
+    def __call__(self, weights: NDArray[np.floating], start: Cell, goal: Cell) -> tuple[NDArray[np.intp], float]:
         """Cells (K, 2) from start to goal (empty when unreachable) and the path cost in cells."""
         ...
 
@@ -27,7 +27,7 @@ class GridSearch(Protocol):
 BACKENDS: Registry[GridSearch] = Registry("grid search")
 
 
-def path_cost(weights: NDArray[np.float64], cells: NDArray[np.integer]) -> float:
+def path_cost(weights: NDArray[np.floating], cells: NDArray[np.integer]) -> float:
     """Cost of a cell path under the shared edge rule (step length times mean weight)."""
     if len(cells) < 2:
         return 0.0 if len(cells) else float("inf")
@@ -50,7 +50,7 @@ def _mcp_factory() -> GridSearch:
     except ImportError:
         raise InputError(f"backend 'mcp' needs scikit-image: {pip_hint('capnav[bench]')}") from None
 
-    def search(weights: NDArray[np.float64], start: Cell, goal: Cell) -> tuple[NDArray[np.intp], float]:
+    def search(weights: NDArray[np.floating], start: Cell, goal: Cell) -> tuple[NDArray[np.intp], float]:
         costs = np.where(np.isfinite(weights), weights, -1.0)  # negative = impassable for MCP
         mcp = MCP_Geometric(costs, fully_connected=True)
         cum, _ = mcp.find_costs([start], [goal])
@@ -70,8 +70,9 @@ def _pyastar_factory() -> GridSearch:
     except ImportError:
         raise InputError(f"backend 'pyastar2d' needs pyastar2d: {pip_hint('capnav[bench]')}") from None
 
-    def search(weights: NDArray[np.float64], start: Cell, goal: Cell) -> tuple[NDArray[np.intp], float]:
-        path = pyastar2d.astar_path(weights.astype(np.float32), start, goal, allow_diagonal=True)
+    def search(weights: NDArray[np.floating], start: Cell, goal: Cell) -> tuple[NDArray[np.intp], float]:
+        # its native float32 (no copy of a float32 costmap: the call is timed as the library's own)
+        path = pyastar2d.astar_path(np.asarray(weights, np.float32), start, goal, allow_diagonal=True)
         if path is None:
             return np.empty((0, 2), np.intp), float("inf")
         cells = np.asarray(path, dtype=np.intp)
@@ -91,7 +92,7 @@ def _tcod_factory() -> GridSearch:
     except ImportError:
         raise InputError(f"backend 'tcod' needs python-tcod: {pip_hint('capnav[bench]')}") from None
 
-    def search(weights: NDArray[np.float64], start: Cell, goal: Cell) -> tuple[NDArray[np.intp], float]:
+    def search(weights: NDArray[np.floating], start: Cell, goal: Cell) -> tuple[NDArray[np.intp], float]:
         cost = np.where(np.isfinite(weights), weights, 0.0).astype(np.float32)  # 0 = blocked for tcod
         steps = tcod.path.AStar(cost, diagonal=float(np.sqrt(2.0))).get_path(start[0], start[1], goal[0], goal[1])
         if not steps and tuple(start) != tuple(goal):

@@ -21,11 +21,12 @@ Cell = tuple[int, int]
 
 @dataclass
 class Costmap:
-    """``weights`` (rows, cols) float64: 1 on free cells, ``unknown_cost`` on unknown ones, ``inf``
-    on obstacles grown by the robot radius plus the safety margin (and on blocked unknown)."""
+    """``weights`` (rows, cols) float32 (half the memory a search walks): 1 on free cells,
+    ``unknown_cost`` on unknown ones, ``inf`` on obstacles grown by the robot radius plus the
+    safety margin (and on blocked unknown). Weights may be raised in place (``mark_blocked``)."""
 
     occ: OccupancyGrid  # the grid as given (not inflated)
-    weights: NDArray[np.float64]
+    weights: NDArray[np.float32]
     columns: HeightColumns | None = None  # observed heights per cell, for 3D lines of sight (planning/sight.py)
     cache: dict[str, Any] = field(default_factory=dict, repr=False)  # per-map results (room regions)
 
@@ -59,7 +60,7 @@ def build_costmap(occ: OccupancyGrid, config: PlannerConfig | None = None,
     cfg = config or PlannerConfig()
     occ = check_occupancy(occ)
     obstacle = occ.cells == OCCUPIED
-    w = np.ones(occ.cells.shape, np.float64)
+    w = np.ones(occ.cells.shape, np.float32)
     if obstacle.any():
         dist = ndimage.distance_transform_edt(~obstacle) * occ.spec.resolution
         if cfg.clearance_cost > 0 and cfg.clearance_band > 0:
