@@ -26,6 +26,7 @@ from capnav.planning.search import (
     OPEN,
     SQRT2,
     TIE_BREAK,
+    _grid,
     _grow,
     _min_finite,
     _pop,
@@ -42,7 +43,7 @@ def _box_h(r: int, c: int, box: NDArray[np.int64]) -> float:
 
 
 @njit(cache=True)
-def _resume(w: NDArray[np.float64], g: NDArray[np.float64], state: NDArray[np.uint8], hf: NDArray[np.float64],
+def _resume(w: NDArray[np.floating], g: NDArray[np.float64], state: NDArray[np.uint8], hf: NDArray[np.float64],
             hi: NDArray[np.int64], size: int, target: NDArray[np.bool_], box: NDArray[np.int64], hscale: float
             ) -> tuple[int, int, NDArray[np.float64], NDArray[np.int64]]:
     """Run until a target cell is settled (returned after expanding it) or the heap is empty (-1)."""
@@ -86,9 +87,9 @@ class NearestSearch:
     in increasing path cost from ``start`` on ``weights``; ``next()`` gives the next one.
     ``min_weight`` (the smallest finite weight) saves a scan of the grid when the caller knows it."""
 
-    def __init__(self, weights: NDArray[np.float64], start: tuple[int, int], target: NDArray[np.bool_],
+    def __init__(self, weights: NDArray[np.floating], start: tuple[int, int], target: NDArray[np.bool_],
                  box: tuple[int, int, int, int], min_weight: float | None = None) -> None:
-        self.w = np.ascontiguousarray(weights, dtype=np.float64)
+        self.w = _grid(np.asarray(weights))  # a float32 costmap as it is: no copy per search
         rows, cols = self.w.shape
         n = rows * cols
         self.cols = cols

@@ -38,14 +38,14 @@ TIE_BREAK = 1e-9
 
 
 @njit(cache=True, nogil=True)
-def _grow(heap: NDArray[np.int64]) -> NDArray[np.int64]:
+def _kgrow(heap: NDArray[np.int64]) -> NDArray[np.int64]:
     out = np.empty(2 * heap.shape[0], np.int64)
     out[:heap.shape[0]] = heap
     return out
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _push(heap: NDArray[np.int64], size: int, key: int) -> None:
+def _kpush(heap: NDArray[np.int64], size: int, key: int) -> None:
     """Insert at ``size`` (capacity checked by the caller) and sift up."""
     k = size
     while k > 0:
@@ -59,7 +59,7 @@ def _push(heap: NDArray[np.int64], size: int, key: int) -> None:
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _pop(heap: NDArray[np.int64], size: int) -> int:
+def _kpop(heap: NDArray[np.int64], size: int) -> int:
     """Remove the smallest key (heap of ``size`` items) and return it."""
     top = heap[0]
     size -= 1
@@ -78,6 +78,63 @@ def _pop(heap: NDArray[np.int64], size: int) -> int:
             break
     heap[k] = key
     return top
+
+
+@njit(cache=True, nogil=True)
+def _grow(hf: NDArray[np.float64], hi: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """A (priority, cell) heap in two arrays, for searches that keep their own state
+    (``planning.nearest``)."""
+    size = hf.shape[0]
+    nf = np.empty(2 * size, np.float64)
+    ni = np.empty(2 * size, np.int64)
+    nf[:size] = hf
+    ni[:size] = hi
+    return nf, ni
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _push(hf: NDArray[np.float64], hi: NDArray[np.int64], size: int, f: float, i: int) -> None:
+    """Insert at ``size`` (capacity checked by the caller) and sift up."""
+    k = size
+    while k > 0:
+        p = (k - 1) >> 1
+        if f < hf[p]:
+            hf[k] = hf[p]
+            hi[k] = hi[p]
+            k = p
+        else:
+            break
+    hf[k] = f
+    hi[k] = i
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _pop(hf: NDArray[np.float64], hi: NDArray[np.int64], size: int) -> int:
+    """Remove the minimum (heap of ``size`` items) and return its index."""
+    top = hi[0]
+    size -= 1
+    f = hf[size]
+    i = hi[size]
+    k = 0
+    while True:
+        m = 2 * k + 1
+        if m >= size:
+            break
+        if m + 1 < size and hf[m + 1] < hf[m]:
+            m += 1
+        if hf[m] < f:
+            hf[k] = hf[m]
+            hi[k] = hi[m]
+            k = m
+        else:
+            break
+    hf[k] = f
+    hi[k] = i
+    return top
+
+
+#: ``state`` of a cell in a search that keeps a byte per cell (``planning.nearest``).
+UNSEEN, OPEN, CLOSED = 0, 1, 2
 
 
 @njit(cache=True, nogil=True)
@@ -133,7 +190,7 @@ def _search(w: NDArray[np.floating], start: int, goal: int, hscale: float, g: ND
     heap[0] = start
     size = 1
     while size > 0:
-        u = _pop(heap, size) & mask
+        u = _kpop(heap, size) & mask
         size -= 1
         if stamp[u] == closed:
             continue
@@ -164,8 +221,8 @@ def _search(w: NDArray[np.floating], start: int, goal: int, hscale: float, g: ND
                 stamp[v] = opened
                 fb[0] = ng + hscale * _octile(vr, vc, gr, gc) if goal >= 0 else ng
                 if size == heap.shape[0]:
-                    heap = _grow(heap)
-                _push(heap, size, (ib[0] & keep) | v)
+                    heap = _kgrow(heap)
+                _kpush(heap, size, (ib[0] & keep) | v)
                 size += 1
     return np.inf, heap
 
