@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -111,3 +112,51 @@ def test_install_from_urls(shared_dir: Path, tmp_path: Path, monkeypatch: pytest
     monkeypatch.setitem(ms.MODELS, name, gone)
     with pytest.raises(ModelError, match="cannot download"):
         ms.install(name, root=tmp_path)
+
+
+def test_install_follows_the_umask(shared_dir: Path, tmp_path: Path) -> None:
+    name = "yolo-fastest-1.1-xl"
+    old = os.umask(0o077)
+    try:
+        out = ms.install(name, root=tmp_path, source_dir=_weights(shared_dir, name))
+    finally:
+        os.umask(old)
+    assert out.stat().st_mode & 0o777 == 0o700
+    assert {p.stat().st_mode & 0o777 for p in out.iterdir()} == {0o600}
+    assert not (out / ".capnav-install-pid").exists()
+
+
+def test_next_install_removes_what_a_killed_one_left(shared_dir: Path, tmp_path: Path) -> None:
+    """A temporary folder whose install process is gone (SIGKILL) is removed by the next install;
+    one whose process still runs (a concurrent install) is left alone."""
+    import subprocess
+    import sys
+
+    name = "yolo-fastest-1.1-xl"
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    gone = tmp_path / f".{name}.killed1"
+    gone.mkdir()
+    (gone / ".capnav-install-pid").write_text(dead.stdout.strip())
+    (gone / f"{name}.weights").write_bytes(b"half a file")
+    running = tmp_path / f".{name}.running"
+    running.mkdir()
+    (running / ".capnav-install-pid").write_text(str(os.getppid()))  # alive: the test runner's parent
+    other = tmp_path / ".yolo-fastest-1.1.killed"  # another model's: not this install's to judge
+    other.mkdir()
+    ms.install(name, root=tmp_path, source_dir=_weights(shared_dir, name))
+    assert not gone.exists() and running.exists() and other.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([name, running.name, other.name])
+
+
+def test_models_install_errors_are_one_line(shared_dir: Path, tmp_path: Path) -> None:
+    import subprocess
+    import sys
+
+    src = str(_weights(shared_dir, "yolo-fastest-1.1-xl"))
+    for args in (["nope"], ["yolo-fastest-1.1-xl", "--from", str(tmp_path / "none")],
+                 ["yolo-fastest-1.1-xl", "--from", src, "--dir", "/sys/capnav-models"],
+                 ["yolo-fastest-1.1-xl", "--from", str(tmp_path)]):
+        r = subprocess.run([sys.executable, "-m", "capnav.cli", "models", "install", *args], capture_output=True,
+                           text=True, timeout=120)
+        assert r.returncode == 2 and r.stderr.startswith("error: "), (args, r.stderr)
+        assert len(r.stderr.strip().splitlines()) == 1, r.stderr

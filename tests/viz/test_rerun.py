@@ -183,3 +183,26 @@ def test_rerun_viewer_opens_and_draws_it(captioned: Path, tmp_path: Path) -> Non
         return int((np.abs(img - np.array(rgb)).max(axis=-1) < 40).sum())
 
     assert near(CHOSEN_RGB) > 50 and near(PATH_RGB) > 50, (near(CHOSEN_RGB), near(PATH_RGB))
+
+
+def test_cli_view_errors_are_one_line(captioned: Path, tmp_path: Path) -> None:
+    """An output folder that cannot be written and a --connect where nothing listens: one
+    ``error:`` line each, before any work, as a user runs the command."""
+    import os
+    import socket
+    import subprocess
+    import sys
+
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o555)
+    target = ro if os.geteuid() != 0 else Path("/sys")  # root writes anywhere but in sysfs
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]  # free once closed: nothing listens there
+    for args, why in (([str(target / "m.rrd")], "is not writable"),
+                      (["--connect", f"rerun+http://127.0.0.1:{port}/proxy"], "nothing listens at 127.0.0.1")):
+        r = subprocess.run([sys.executable, "-m", "capnav.cli", "view", str(captioned), *(["-o"] if "--connect" not in
+                            args else []), *args], capture_output=True, text=True, timeout=120)
+        assert r.returncode == 2 and r.stderr.startswith("error: ") and why in r.stderr, r.stderr
+        assert len(r.stderr.strip().splitlines()) == 1, r.stderr

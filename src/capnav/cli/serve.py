@@ -36,7 +36,7 @@ def register(app: typer.Typer) -> None:
             help=f"bearer token every /api request must carry (default: ${TOKEN_ENV}); required off loopback")
                          ] = None,
         workers: Annotated[int, typer.Option(min=1, max=64, help="worker threads that answer asks")] = 2,
-        queue: Annotated[int, typer.Option(min=0, help="asks that may wait for a worker (more: 503)")] = 32,
+        queue: Annotated[int, typer.Option(min=0, help="asks that may wait for a worker (more: 503)")] = 64,
         time_limit: Annotated[float, typer.Option(min=0.01, help="seconds an ask may take (else 503)")] = 10.0,
         body_timeout: Annotated[float, typer.Option(min=0.01, help="seconds to receive a request body")] = 10.0,
         header_timeout: Annotated[float, typer.Option(min=0.01, help="seconds to receive request headers")] = 10.0,

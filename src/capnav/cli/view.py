@@ -2,10 +2,41 @@
 
 from __future__ import annotations
 
+import socket
+import tempfile
 from pathlib import Path
 from typing import Annotated
+from urllib.parse import urlparse
 
 import typer
+
+from capnav.core.errors import InputError, OutputError
+
+
+def check_writable(out: Path) -> None:
+    """One line, before any work, when the recording cannot be written where asked."""
+    parent = out.expanduser().resolve().parent
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=parent, prefix=".capnav-probe-"):
+            pass
+    except OSError as e:
+        raise OutputError(f"cannot write {out}: {parent} is not writable ({e.strerror or e})") from None
+
+
+def check_listening(url: str) -> None:
+    """One line when nothing listens at the viewer's address (rerun would retry for seconds and
+    then print its own errors)."""
+    u = urlparse(url)
+    if not u.hostname:
+        raise InputError(f"--connect must be a rerun gRPC URL like rerun+http://127.0.0.1:9876/proxy, got {url!r}")
+    port = u.port or 9876
+    try:
+        with socket.create_connection((u.hostname, port), timeout=3):
+            pass
+    except OSError as e:
+        raise InputError(f"nothing listens at {u.hostname}:{port} ({e.strerror or e}): start the viewer first "
+                         f"(`rerun`), or leave out --connect to write an .rrd file") from None
 
 
 def register(app: typer.Typer) -> None:
@@ -35,6 +66,10 @@ def register(app: typer.Typer) -> None:
         from capnav.viz.rerun_log import write_rrd
 
         xy = parse_xy(robot)
+        if connect:
+            check_listening(connect)
+        else:
+            check_writable(out)
         nav = CapNav.open(map_path)
         con = make_console(stderr=True)
         if xy is None and query and nav.map.trajectory is not None and len(nav.map.trajectory):
@@ -46,7 +81,12 @@ def register(app: typer.Typer) -> None:
             ans = nav.ask(text, robot=xy)
             plan = nav.plan(xy, ans) if xy is not None and ans.goal is not None else None
             answers.append((ans, plan))
-        path = write_rrd(nav.map, out, answers, connect=connect, max_voxels=max_voxels, max_z=max_z)
+        try:
+            path = write_rrd(nav.map, out, answers, connect=connect, max_voxels=max_voxels, max_z=max_z)
+        except RuntimeError as e:  # rerun's own errors (a viewer that went away, a file it cannot create)
+            first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+            raise OutputError(f"rerun could not {'send to ' + connect if connect else 'write ' + str(out)}: "
+                              f"{first}") from None
         for ans, plan in answers:
             got = f"object {ans.object.id}: {ans.object.caption}" if ans.object else "not found"
             con.print(f'"{ans.instruction}" -> {got}' + (f"; path {plan.length_m:.2f} m" if plan else ""),

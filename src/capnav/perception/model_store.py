@@ -149,7 +149,9 @@ def install(name: str, root: str | Path | None = None, source_dir: str | Path | 
     dest_root = models_root(root)
     try:
         dest_root.mkdir(parents=True, exist_ok=True)
+        remove_stale(dest_root, name)
         tmp = Path(tempfile.mkdtemp(prefix=f".{name}.", dir=dest_root))
+        (tmp / _OWNER).write_text(str(os.getpid()))
     except OSError as e:
         raise InputError(f"cannot use {dest_root} as the model folder: {e.strerror or e}") from None
     try:
@@ -180,8 +182,10 @@ def _fill(s: ModelSpec, tmp: Path, src: Path | None, dest_root: Path, timeout: f
         "installed_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
         "files": {f.name: {"sha256": f.sha256, "url": f.url} for f in s.files},
     })
-    for p in (tmp, *tmp.iterdir()):  # mkdtemp / mkstemp make owner-only files
-        p.chmod(0o755 if p.is_dir() else 0o644)
+    (tmp / _OWNER).unlink()
+    mask = _umask()
+    for p in (tmp, *tmp.iterdir()):  # mkdtemp / mkstemp make owner-only files: give the umask's modes
+        p.chmod((0o777 if p.is_dir() else 0o666) & ~mask)
     out = dest_root / name
     old = None
     if out.exists():
@@ -192,6 +196,50 @@ def _fill(s: ModelSpec, tmp: Path, src: Path | None, dest_root: Path, timeout: f
     if old is not None:
         shutil.rmtree(old, ignore_errors=True)
     return out
+
+
+#: A file in an install's temporary folder naming the process that fills it.
+_OWNER = ".capnav-install-pid"
+#: A temporary folder with no owner file is stale after this long (its install died at once).
+_STALE_S = 600.0
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True  # another user's live process
+    return True
+
+
+def remove_stale(dest_root: Path, name: str) -> list[Path]:
+    """Remove what earlier installs of ``name`` left behind when they were killed: temporary
+    folders whose process is gone, and a ``.NAME.old`` beside an installed copy. Returns them."""
+    removed = []
+    for p in dest_root.glob(f".{name}.*"):
+        if not p.is_dir():
+            continue
+        if p.name == f".{name}.old":
+            stale = (dest_root / name).is_dir()
+        else:
+            owner = p / _OWNER
+            try:
+                pid = int(owner.read_text().strip())
+                stale = pid != os.getpid() and not _alive(pid)
+            except (OSError, ValueError):
+                stale = time.time() - p.stat().st_mtime > _STALE_S
+        if stale:
+            shutil.rmtree(p, ignore_errors=True)
+            removed.append(p)
+    return removed
 
 
 def installed(root: str | Path | None = None) -> list[dict[str, Any]]:

@@ -63,7 +63,7 @@ class ServeConfig:
     max_k: int = 20
     warm_up: bool = True  # load the embedder and compile the planner at start-up, not on the first question
     workers: int = 2
-    queue: int = 32
+    queue: int = 64
     time_limit: float = 10.0
     max_depth: int = 16
     max_elements: int = 2_000
