@@ -345,6 +345,10 @@ def goal_query(g: GoalParse, embedder: TextEmbedder | None = None) -> ParsedQuer
     q.origin_room = g.origin_room
     q.side = g.side
     q.structure = describe(g)
+    if q.ordinal is None:
+        # "the second bookshelf from the door", "the first desk you reach": an ordinal on the head,
+        # counted in the order a route or a predicate gives.
+        q.ordinal = next((_ORDINALS[m.lower()] for m in g.modifiers if m.lower() in _ORDINALS), None)
     if q.origin_room is not None and q.room == q.origin_room:
         q.room = next((r for role, r in g.rooms if role == "target" and r != q.origin_room), None)
     return q

@@ -51,7 +51,8 @@ _LANDMARK_PREPS = {"to", "by", "beside", "besides", "near", "behind", "opposite"
 #: "sit on the bed"), not on another noun or adverb ("next to the sofa", "the lamp on the table").
 _GOAL_PREPS = {"to", "towards", "toward", "into", "onto", "on", "at", "over", "in", "inside", "for", "with"}
 #: Where a room stands in a route: the target's own room, where one comes from, what one passes.
-_ROOM_ORIGIN = {"from", "out", "leaving", "leave", "exit", "exiting"}
+_ROOM_ORIGIN = {"from", "out", "leaving", "leave", "exit", "exiting", "door"}
+_DOORS = {"door", "doorway", "entrance", "entry", "archway", "opening", "doors"}
 _ROOM_PASSED = {"through", "past", "via", "across", "along"}
 _ROOM_DEST = {"into", "to", "towards", "toward", "entering", "enter", "onto"}
 _NEGATIVE = {"not", "n't", "except", "other", "than", "but", "without", "nor"}
@@ -255,6 +256,8 @@ def _is_landmark(t: Token) -> bool:
 def _governor(t: Token) -> str:
     """The preposition or verb that governs a room noun, with "out of" read as one word."""
     h = t.head
+    if (t.dep_ == "pobj" and h.head.lower_ in _DOORS) or (t.dep_ == "compound" and h.lower_ in _DOORS):
+        return "door"  # "the door to the hall", "the hall door": the room on the door's other side
     if t.dep_ == "pobj":
         w = h.text.lower()
         if w == "of" and h.head.text.lower() == "out":
