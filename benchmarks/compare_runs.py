@@ -60,16 +60,23 @@ def table(runs: list[tuple[str, dict[str, Any]]], protocol: str) -> list[str]:
     methods = [m for m in ORDER if any(m in b for b in by)] + sorted({m for b in by for m in b} - set(ORDER))
     if not methods:
         return []
-    head = "| Method | " + " | ".join(f"{label}: indep. / strict / 4 in a row" for label, _ in runs) + " |"
-    lines = [f"**{protocol}** (subgoal success %, paper rule / strict; full 4-subgoal chains, paper rule)", "",
-             head, "|---|" + "---:|" * len(runs)]
+    mean = len(runs) > 1
+    head = "| Method | " + " | ".join(f"{label}: indep. [95% CI] / strict / 4 in a row" for label, _ in runs) \
+        + (" | mean indep. of the runs |" if mean else " |")
+    lines = [f"**{protocol}** (subgoal success %, paper rule with its bootstrap 95% interval over episodes / strict; "
+             "full 4-subgoal chains, paper rule)", "", head, "|---|" + "---:|" * (len(runs) + mean)]
     for m in methods:
         cells = []
         for b in by:
             s = b.get(m)
+            ci = s.get("independent_ci") if s is not None else None
             cells.append("–" if s is None else
-                         f"{pct(s['independent'])} / {pct(s.get('independent_strict'))} / "
+                         f"{pct(s['independent'])}" + (f" [{pct(ci[0])}-{pct(ci[1])}]" if ci else "")
+                         + f" / {pct(s.get('independent_strict'))} / "
                          f"{pct(s['in_a_row'][-1] if s['in_a_row'] else None)}")
+        if mean:
+            vals = [b[m]["independent"] for b in by if m in b]
+            cells.append(pct(sum(vals) / len(vals)) if vals else "–")
         lines.append(f"| {m} | " + " | ".join(cells) + " |")
     return lines
 

@@ -68,3 +68,22 @@ def test_unreachable_scene_is_a_clear_error() -> None:
     t.navigable[0, 0] = True
     with pytest.raises(DatasetError, match="no valid label episode"):
         label_episodes(t, np.random.default_rng(0), EpisodeConfig(episodes_per_scene=1, max_tries=5))
+
+
+def test_starts_keep_the_planners_margin_and_a_way_out() -> None:
+    from capnav.eval.generate import start_cells
+
+    # A 2 m room (clearance grows from its walls) with a pocket joined to it by a neck whose
+    # clearance is the robot's radius only: the pocket is navigable but no start is drawn there.
+    clearance = np.zeros((40, 80))
+    rr, cc = np.mgrid[0:40, 0:80]
+    room = (cc < 40) & (rr > 0) & (rr < 39) & (cc > 0)
+    clearance[room] = np.minimum.reduce([rr[room], 39 - rr[room], cc[room], 40 - cc[room]]) * 0.05
+    pocket = (cc > 45) & (cc < 70) & (rr > 10) & (rr < 30)
+    clearance[pocket] = 0.6
+    neck = (cc >= 40) & (cc <= 45) & (rr >= 18) & (rr <= 21)
+    clearance[neck] = 0.21
+    inside = clearance > 0.2
+    ok = start_cells(clearance, inside, 0.3)
+    assert ok[20, 20] and not ok[20, 60] and not ok[2, 20]  # the room's middle; not the pocket, not by a wall
+    assert (clearance[ok] > 0.3).all()

@@ -79,3 +79,16 @@ def test_summarize_all_groups() -> None:
                                                                                protocol="description")]
     out = {(s.method, s.protocol): s.independent for s in summarize_all(rs)}
     assert out == {("x", "label"): 1.0, ("y", "label"): 0.0, ("y", "description"): 1.0}
+
+
+def test_bootstrap_interval_resamples_episodes_and_brackets_the_rate() -> None:
+    from capnav.eval.metrics import bootstrap_ci
+
+    chains = [[True] * 4] * 15 + [[True, False, False, False]] * 5  # 65 of 80 subgoals
+    lo, hi = bootstrap_ci(chains)
+    assert lo < 65 / 80 < hi and hi - lo > 0.05
+    assert bootstrap_ci(chains) == [lo, hi]  # seeded
+    assert bootstrap_ci([[True] * 4] * 10) == [1.0, 1.0]
+    # more episodes of the same mix: a narrower interval
+    lo2, hi2 = bootstrap_ci(chains * 9)
+    assert hi2 - lo2 < hi - lo

@@ -25,7 +25,7 @@ from capnav.core.limits import check_count, check_image_size
 from capnav.core.text import shorten
 from capnav.demo.report import Report, ReportItem, verdict, write_html, write_markdown
 from capnav.eval.drive import run_instruction
-from capnav.eval.generate import SceneTruth
+from capnav.eval.generate import SceneTruth, start_cells
 from capnav.eval.success import SUCCESS_RADIUS_M, distance_to_instances
 from capnav.mapping.objects import MapObject
 from capnav.pipeline import PipelineConfig, SimScene, open_sim_scene
@@ -96,7 +96,10 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
     assets = open_sim_scene(cfg.seed, cfg.seed, pcfg, out)  # the product pipeline: it never reads the truth
     sim = assets.sim
     nav_truth = sim.navigable()  # the simulator's truth: only to pick starts and instructions and to judge
-    truth = SceneTruth.from_manifest(sim.manifest, nav_truth.spec, nav_truth.cells == FREE)
+    truth = SceneTruth.from_manifest(
+        sim.manifest, nav_truth.spec, nav_truth.cells == FREE,
+        starts=start_cells(sim.nav_grid().clearance, nav_truth.cells == FREE,
+                           PlannerConfig().inflation + nav_truth.spec.resolution))
     con.print(f"     {len(sim.manifest.rooms)} rooms, {len(sim.manifest.objects)} objects "
               f"({time.perf_counter() - t0:.1f} s)")
     from capnav.viz.scene import draw_scene

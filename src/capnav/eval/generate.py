@@ -39,6 +39,21 @@ class EpisodeConfig:
             raise InputError(f"need >= 1 episode and subgoal, got {self.episodes_per_scene}, {self.subgoals}")
 
 
+def start_cells(clearance: NDArray[np.floating], inside: NDArray[np.bool_], margin: float) -> NDArray[np.bool_]:
+    """Where an episode may start: cells whose clearance to every true obstacle exceeds ``margin``
+    (the planner's inflation and a map cell: the start is free on the robot's own costmap, not
+    only on the true grid), in the largest region connected through such cells (so the way out of
+    the start has the margin too, not just the robot's radius)."""
+    from scipy import ndimage
+
+    fits = np.asarray(inside, dtype=bool) & (np.asarray(clearance) > margin)
+    labels, n = ndimage.label(fits, structure=np.ones((3, 3), dtype=bool))
+    if n == 0:
+        return fits
+    sizes = ndimage.sum_labels(np.ones_like(labels), labels, index=np.arange(1, n + 1))
+    return np.asarray(labels == int(np.argmax(sizes)) + 1)
+
+
 @dataclass
 class SceneTruth:
     """Ground truth the harness scores against: instances (id -> category, footprint) and the
@@ -51,15 +66,18 @@ class SceneTruth:
     navigable: NDArray[np.bool_]
     radius: float = SUCCESS_RADIUS_M
     sight: SightGrid | None = None  # walls and tall objects, for the strict (line-of-sight) success rule
+    starts: NDArray[np.bool_] | None = None  # where a start may be drawn (default: every navigable cell)
     _fields: dict[tuple[int, ...], DistanceField] = field(default_factory=dict, repr=False)
 
     @classmethod
     def from_manifest(cls, manifest: object, spec: GridSpec, navigable: NDArray[np.bool_],
-                      radius: float = SUCCESS_RADIUS_M, sight: SightGrid | None = None) -> SceneTruth:
+                      radius: float = SUCCESS_RADIUS_M, sight: SightGrid | None = None,
+                      starts: NDArray[np.bool_] | None = None) -> SceneTruth:
         objs = manifest.objects  # type: ignore[attr-defined]
         return cls(int(manifest.seed), {o.id: o.category for o in objs},  # type: ignore[attr-defined]
                    {o.id: np.asarray(o.footprint, dtype=np.float64) for o in objs}, spec,
-                   np.asarray(navigable, dtype=bool), radius, sight)
+                   np.asarray(navigable, dtype=bool), radius, sight,
+                   None if starts is None else np.asarray(starts, dtype=bool))
 
     def sees_goal(self, xy: tuple[float, float], target_ids: Sequence[int]) -> bool | None:
         """Strict success's second half: is one of the goal instances within ``radius`` AND in sight
@@ -87,7 +105,7 @@ class SceneTruth:
         return self._fields[key]
 
     def sample_start(self, rng: np.random.Generator) -> StartPose:
-        cells = np.argwhere(self.navigable)
+        cells = np.argwhere(self.navigable if self.starts is None or not self.starts.any() else self.starts)
         if len(cells) == 0:
             raise DatasetError(f"scene {self.scene_seed} has no navigable cell")
         rc = cells[int(rng.integers(len(cells)))]

@@ -113,6 +113,8 @@ class Summary:
     #: The same two figures under the strict rule (stopped within 1 m AND in sight); None without it.
     in_a_row_strict: list[float] | None = None
     independent_strict: float | None = None
+    #: Bootstrap 95% interval of ``independent`` (episodes resampled: subgoals of one episode share a start).
+    independent_ci: list[float] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -148,6 +150,21 @@ def chains_of(records: Iterable[SubgoalRecord], strict: bool = False) -> list[li
     return chains
 
 
+def bootstrap_ci(groups: Sequence[Sequence[bool]], resamples: int = 2000, level: float = 0.95, seed: int = 0
+                 ) -> list[float]:
+    """Percentile bootstrap interval of the success rate over all items, resampling whole groups
+    (episodes) with replacement; seeded, so a report is reproducible."""
+    if not groups:
+        return [0.0, 0.0]
+    ok = np.array([sum(map(bool, g)) for g in groups], dtype=np.float64)
+    n = np.array([len(g) for g in groups], dtype=np.float64)
+    rng = np.random.default_rng(seed)
+    idx = rng.integers(0, len(groups), size=(resamples, len(groups)))
+    rates = ok[idx].sum(axis=1) / np.maximum(n[idx].sum(axis=1), 1.0)
+    a = (1.0 - level) / 2.0
+    return [float(np.quantile(rates, a)), float(np.quantile(rates, 1.0 - a))]
+
+
 def summarize(records: Sequence[SubgoalRecord]) -> Summary:
     """All metrics for the records of ONE (method, protocol)."""
     if not records:
@@ -177,6 +194,7 @@ def summarize(records: Sequence[SubgoalRecord]) -> Summary:
         crashes=sum(1 for r in records if r.error),
         in_a_row_strict=in_a_row(chains_of(records, strict=True)) if has_strict else None,
         independent_strict=float(np.mean([bool(r.success_strict) for r in records])) if has_strict else None,
+        independent_ci=bootstrap_ci(chains),
     )
 
 
