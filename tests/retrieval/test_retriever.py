@@ -37,7 +37,7 @@ def test_attribute_superlative_relation_room(cmap, emb):
 
 
 def test_closest_uses_grid_distance(cmap, emb):
-    r = Retriever(cmap, emb)
+    r = Retriever(cmap, emb, config=RetrievalConfig(distance="straight"))  # eq. 17 (walking: test_walking_distance)
     a = r.query("the closest chair", robot_xy=(6.5, 3.0))
     b = r.query("the closest chair", robot_xy=(1.5, 4.0))
     assert (a.chosen.id, b.chosen.id) == (4, 5) and a.mode == "closest" and a.predicate == "closest"

@@ -45,6 +45,9 @@ def register(app: typer.Typer) -> None:
                                  ] = None,
         verifier: Annotated[str, typer.Option(help="verification backend: offline, none, gemini, openai, ...")
                             ] = "offline",
+        distance: Annotated[str, typer.Option(
+            help="how 'closest' measures: walking (along the map's floor) or straight (eq. 17 grid distance)")
+                            ] = "walking",
         through_unknown: Annotated[bool, typer.Option(
             "--through-unknown", help="accept a planned path that crosses unknown space (default: such a plan is "
                                       "reported as not ok)")] = False,
@@ -58,7 +61,7 @@ def register(app: typer.Typer) -> None:
         from capnav.io.mapfile import load_map
         from capnav.language import create_embedder
         from capnav.language.embedder import EMBEDDERS
-        from capnav.retrieval import Retriever, create_verifier
+        from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
 
         if occupancy not in OCCUPANCY_KINDS:  # fail before the slow loading below
             raise InputError(f"occupancy must be one of {', '.join(OCCUPANCY_KINDS)}, got {occupancy!r}")
@@ -84,7 +87,7 @@ def register(app: typer.Typer) -> None:
             raise InputError("--occupancy truth needs the simulator: it applies only when driving (--drive)")
         emb = create_embedder(embedder, **({"path": str(embedder_path)} if embedder_path else {}))
         ver_kw = {"embedder": emb} if verifier == "offline" else {}
-        retriever = Retriever(cmap, emb, create_verifier(verifier, **ver_kw))
+        retriever = Retriever(cmap, emb, create_verifier(verifier, **ver_kw), RetrievalConfig(distance=distance))
         con = make_console(stderr=True)
         from capnav.retrieval.query import parse_goals
 

@@ -34,6 +34,8 @@ def register(app: typer.Typer) -> None:
                                        help="attribute heuristic; --no-heuristic is the paper's ablation"),
         embedder: str = typer.Option("auto", help="auto (the map's default model) or a backend name"),
         embedder_path: Path | None = typer.Option(None, help="local model folder for non-default embedders"),
+        distance: str = typer.Option("walking", help="how 'closest' measures: walking (along the map's floor) or "
+                                                     "straight (the paper's eq. 17 grid distance)"),
     ) -> None:
         """Retrieve the object an instruction describes (paper 3.4); exit code 1 when nothing matches
         (0 with --json, whose payload says "found": false)."""
@@ -72,7 +74,7 @@ def register(app: typer.Typer) -> None:
             from capnav.planning.position import place_robot
 
             xy, robot_note = place_robot(cmap.occupancy, xy, "--robot")
-        cfg = RetrievalConfig(use_verifier=verifier != "none", use_attribute_heuristic=heuristic)
+        cfg = RetrievalConfig(use_verifier=verifier != "none", use_attribute_heuristic=heuristic, distance=distance)
         seq = query_goals(Retriever(cmap, emb, create_verifier(verifier), cfg), instruction, robot_xy=xy)
         if as_json:
             typer.echo(json.dumps(seq.to_dict() | ({"robot_note": robot_note} if robot_note else {}), indent=2))

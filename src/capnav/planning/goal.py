@@ -51,12 +51,13 @@ class GoalPose:
     path_cost: float
     in_sight: bool | None = None
     in_room: bool | None = None
+    on_seen_floor: bool = True  # False: the only cells within reach are unknown space
 
     def to_dict(self) -> dict[str, Any]:
         return {"xy": [round(float(v), 4) for v in self.xy], "yaw": round(self.yaw, 4), "cell": list(self.cell),
                 "reached_within_reach": self.reached_within_reach, "reason": self.reason,
                 "distance_to_object": round(self.distance_to_object, 4), "path_cost": round(self.path_cost, 4),
-                "in_sight": self.in_sight, "in_room": self.in_room}
+                "in_sight": self.in_sight, "in_room": self.in_room, "on_seen_floor": self.on_seen_floor}
 
 
 def check_footprint(footprint: object) -> NDArray[np.float64]:
@@ -172,6 +173,15 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
                     f"the nearest reachable free cell within reach ({short})")
             return _pose(rc[i], centres[i], fp, True, f"{what} {dist[i]:.2f} m from the object{why}",
                          float(dist[i]), float(cost[i]), in_sight, room)
+    # No seen free floor within reach is reachable: a traversable unknown cell within reach, said so
+    # (the map may have missed the floor in an occlusion shadow; on_map reports such a goal as not ok).
+    unseen = np.isfinite(cm.weights[win].ravel()) & ~free & (dist <= cfg.reach) & reach_ok
+    if unseen.any():
+        k = unseen & (dist <= cfg.reach - cfg.goal_margin)
+        i = _pick(np.nonzero(k if k.any() else unseen)[0], cost, dist, not k.any(), spec.resolution)
+        return _pose(rc[i], centres[i], fp, True, f"an unknown cell {dist[i]:.2f} m from the object: no reachable "
+                     "cell of seen free floor lies within reach", float(dist[i]), float(cost[i]), None, None,
+                     on_seen_floor=False)
     # Out of reach: the reachable seen free cell closest to the object, over the whole grid.
     ok_all = np.isfinite(field) & (cm.occ.cells == FREE)
     if not ok_all.any():  # stay where the robot stands rather than stop on floor nobody saw
@@ -232,9 +242,10 @@ def polygon_centroid(fp: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def _pose(cell: NDArray[np.intp], xy: NDArray[np.float64], fp: NDArray[np.float64], within: bool, reason: str,
-          dist: float, cost: float, in_sight: bool | None, in_room: bool | None) -> GoalPose:
+          dist: float, cost: float, in_sight: bool | None, in_room: bool | None, on_seen_floor: bool = True
+          ) -> GoalPose:
     centre = polygon_centroid(fp)
     d = centre - xy
     yaw = float(np.arctan2(d[1], d[0])) if np.hypot(*d) > 1e-9 else 0.0
     return GoalPose(np.asarray(xy, dtype=np.float64), yaw, (int(cell[0]), int(cell[1])), within, reason, dist, cost,
-                    in_sight, in_room)
+                    in_sight, in_room, on_seen_floor)

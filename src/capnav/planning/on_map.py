@@ -113,7 +113,7 @@ class MapNavigation:
         """A path to a goal pose within reach of the chosen object, over seen free floor only
         unless ``through_unknown``."""
         return self.path is not None and self.goal is not None and self.goal.reached_within_reach \
-            and (self.through_unknown or self.unknown_m <= 0.0)
+            and (self.through_unknown or (self.unknown_m <= 0.0 and self.goal.on_seen_floor))
 
     def to_dict(self) -> dict[str, Any]:
         g = self.goal
@@ -121,7 +121,10 @@ class MapNavigation:
                 "start": {"x": round(self.start[0], 4), "y": round(self.start[1], 4), "yaw": round(self.start[2], 4),
                           "source": self.start_source},
                 "goal": None if g is None else {"x": round(float(g.xy[0]), 4), "y": round(float(g.xy[1]), 4),
-                                                "yaw": round(g.yaw, 4), "ok": g.reached_within_reach, **g.to_dict()},
+                                                "yaw": round(g.yaw, 4),
+                                                "ok": g.reached_within_reach
+                                                and (g.on_seen_floor or self.through_unknown),
+                                                **g.to_dict()},
                 "path": None if self.path is None else {
                     **self.path.to_dict(), "seen_free_m": round(self.seen_free_m, 4),
                     "unknown_m": round(self.unknown_m, 4),
@@ -165,16 +168,17 @@ def navigate_on_map(cmap: CapNavMap, retriever: Retriever, instruction: str | Pa
         out.reason = f"no path to object {query.chosen.id} ({query.chosen.label}): {e}"
         return out
     out.seen_free_m, out.unknown_m = floor_along(occ, out.path.waypoints)
-    if out.unknown_m > 0 and not through_unknown:
+    if (out.unknown_m > 0 or not out.goal.on_seen_floor) and not through_unknown:
         _over_seen_floor(out, occ, query.chosen, xy, cfg, cm.columns)
     out.notes += out.path.notes
     if out.goal.reached_within_reach:
         out.reason = (f"A* path of {out.path.length_m:.2f} m to {out.goal.reason} (grid {cm.spec.resolution:.2f} m, "
                       f"obstacles inflated by {cfg.inflation:.2f} m)")
-        if out.unknown_m > 0:
-            out.reason = (f"the path crosses {out.unknown_m:.2f} m of unknown space (of {out.path.length_m:.2f} m): "
-                          + ("accepted (--through-unknown); " if through_unknown else
-                             "not planned over floor nobody saw (pass --through-unknown to accept it); ")
+        if out.unknown_m > 0 or not out.goal.on_seen_floor:
+            what = (f"the path crosses {out.unknown_m:.2f} m of unknown space (of {out.path.length_m:.2f} m)"
+                    if out.unknown_m > 0 else "the goal stands on unknown space")
+            out.reason = (f"{what}: " + ("accepted (--through-unknown); " if through_unknown else
+                                         "not planned over floor nobody saw (pass --through-unknown to accept it); ")
                           + out.reason)
     else:
         out.reason = f"the object is out of reach from the start: {out.goal.reason}"
@@ -195,7 +199,8 @@ def _over_seen_floor(out: MapNavigation, occ: OccupancyGrid, chosen: Any, xy: tu
     except CapNavError:
         return
     seen, unknown = floor_along(occ, path.waypoints)
-    if goal.reached_within_reach and unknown < out.unknown_m:
+    assert out.goal is not None
+    if goal.reached_within_reach and goal.on_seen_floor and (unknown < out.unknown_m or not out.goal.on_seen_floor):
         out.notes.append(f"planned over seen floor: the cheapest path crossed {out.unknown_m:.2f} m of unknown space")
         out.goal, out.path, out.seen_free_m, out.unknown_m = goal, path, seen, unknown
 

@@ -34,8 +34,13 @@ class RetrievalConfig:
     #: best one's are excluded too (a paler fit is "the other one": a light grey machine is not
     #: "the white washing machine" when a white one stands in the map).
     negation_contrast: float = 0.75
+    #: How "closest" / "farthest" (to the robot or to a landmark) measure: "walking", along the
+    #: map's floor (one Dijkstra per source), or "straight", the paper's eq. 17 grid distance.
+    distance: str = "walking"
 
     def __post_init__(self) -> None:
+        if self.distance not in ("walking", "straight"):
+            raise InputError(f"distance must be 'walking' or 'straight', got {self.distance!r}")
         if self.top_k < 1 or self.batch_size < 1 or self.max_batches < 1:
             raise InputError("top_k, batch_size and max_batches must be >= 1")
         if not 0.0 <= self.mmr_lambda <= 1.0:

@@ -30,6 +30,7 @@ from capnav.retrieval.config import RetrievalConfig
 from capnav.retrieval.query import ParsedQuery, parse_instruction
 from capnav.retrieval.ranking import Ranking, cosine_scores
 from capnav.retrieval.result import QueryResult
+from capnav.retrieval.spatial import FloorDistances
 from capnav.retrieval.verifier import AcceptFirst, Assessment, Candidate, OfflineVerifier, Verifier, a
 
 _VOCAB = set(NAMES)
@@ -72,6 +73,7 @@ class Retriever:
         purpose.use_stored_glosses(embedder, cmap.caches.get(purpose.CACHE_KEY))
         self.grid = occ.spec if occ is not None else self._grid_from_objects()
         self.cells = self.grid.to_cell(np.array([o.position[:2] for o in self.objects]))
+        self._floor: FloorDistances | None = None  # walking distances, built on the first "closest"
         # An object's category: the caption's name when it is a vocabulary word, else its label.
         self.cats = []
         for o in self.objects:
@@ -105,6 +107,28 @@ class Retriever:
         rc = self.grid.to_cell(np.asarray(robot_xy, dtype=np.float64))
         d = np.hypot(self.cells[:, 0] - rc[0], self.cells[:, 1] - rc[1])
         return np.asarray(d * self.grid.resolution, dtype=np.float64)
+
+    def robot_distance(self, robot_xy: tuple[float, float]) -> tuple[NDArray[np.float64], str]:
+        """Distances from the robot to every object and what they measure: along the floor
+        (``RetrievalConfig.distance == "walking"``, when the map has a grid and the robot stands
+        where a walk starts) else eq. 17's straight grid distance."""
+        floor = self.floor_distances()
+        if floor is not None:
+            d = floor.from_point(robot_xy)
+            if np.isfinite(d).any():
+                return np.where(np.isfinite(d), d, self.grid_distance(robot_xy) + 1e6), "walking"
+        return self.grid_distance(robot_xy), "straight"
+
+    def floor_distances(self) -> FloorDistances | None:
+        """The walking distances of this map (None with ``distance="straight"`` or no occupancy)."""
+        occ = getattr(self.cmap, "occupancy", None)
+        if self.config.distance != "walking" or occ is None:
+            return None
+        if self._floor is None:
+            los = np.array([o.extent_min[:2] for o in self.objects], dtype=np.float64)
+            his = np.array([o.extent_max[:2] for o in self.objects], dtype=np.float64)
+            self._floor = FloorDistances(occ, los, his)
+        return self._floor
 
     def of_category(self, cat: str) -> NDArray[np.intp]:
         """Indices of the objects of category ``cat``."""
@@ -162,10 +186,12 @@ class Retriever:
         t3 = time.perf_counter()
         timings = {"embed": t1 - t0, "rank": t2 - t1, "verify": t3 - t2}
         runners = self._runners_up(rk, s, judged, chosen_i)
-        dist = None
+        dist, dist_kind = None, "straight"
         if robot_xy is not None and chosen_i is not None:
-            dist = float(self.grid_distance(robot_xy)[chosen_i])
-        reason = self._explain(q, chosen_i, s, rk, notes, verdict_reason, dist, verifier, runners, judged)
+            d, dist_kind = self.robot_distance(robot_xy)
+            dist = float(d[chosen_i])
+        reason = self._explain(q, chosen_i, s, rk, notes, verdict_reason, dist, verifier, runners, judged,
+                               dist_kind)
         return QueryResult(q.text, self.objects[chosen_i] if chosen_i is not None else None, chosen_i is not None,
                            float(s[chosen_i]) if chosen_i is not None else 0.0,
                            [(self.objects[i], sc) for i, sc, _, _ in runners], predicate, reason, timings,
@@ -226,7 +252,8 @@ class Retriever:
 
     def _explain(self, q: ParsedQuery, i: int | None, s: NDArray[np.float32], rk: Ranking, notes: list[str],
                  verdict: str, dist: float | None, verifier: Verifier,
-                 runners: list[tuple[int, float, dict[str, float], str]], judged: dict[int, Assessment]) -> str:
+                 runners: list[tuple[int, float, dict[str, float], str]], judged: dict[int, Assessment],
+                 dist_kind: str = "straight") -> str:
         target = q.target_phrase or q.text
         if i is None:
             base = f"Not found: nothing in the map is {a(target)}"
@@ -240,7 +267,8 @@ class Retriever:
         mode, predicate = rk.mode, rk.predicate
         if mode == "closest":
             how = f"it is the {predicate} {q.category or target} to the robot" \
-                  + (f" ({dist:.1f} m in the grid)" if dist is not None else "")
+                  + ("" if dist is None else f" ({dist:.1f} m walking along the floor)"
+                     if dist_kind == "walking" else f" ({dist:.1f} m in a straight line on the grid)")
         elif mode == "predicate":
             how = f"it best satisfies '{predicate}'"
         elif i in judged and judged[i].ok:

@@ -1,16 +1,20 @@
 """Geometry of the relations that need more than the gap between two boxes: "between" two
-landmarks and "at the end of" a long one.
+landmarks, "at the end of" a long one, and distances along the floor.
 
 Why: "the table between the sofa and the armchair" is the object on the line joining the two,
 not the one nearest either; "the chair at the end of the table" sits beyond a short edge of the
 table, not along its long side. Both are measured on what the map observed: object centres and
-the footprint (convex hull of the fused points in x, y).
+the footprint (convex hull of the fused points in x, y). "The nearest plant to me" is the one the
+robot walks to first, not the one nearest through a wall: :class:`FloorDistances` measures along
+the map's floor (paper eq. 17's straight grid distance stays an option, ``RetrievalConfig.distance``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
+
+from capnav.core.grid import OCCUPIED, OccupancyGrid
 
 #: Below this length / width ratio a footprint has no long axis, so no "end" (a round or square
 #: table): "at the end of" is then read as "next to".
@@ -68,4 +72,55 @@ def end_distance(p: NDArray[np.float64], footprint: NDArray[np.float64]) -> floa
     return float(min(np.linalg.norm(p - (centre + hl * u)), np.linalg.norm(p - (centre - hl * u))))
 
 
-__all__ = ["MIN_ELONGATION", "end_distance", "has_long_axis", "oriented_box", "segment_distance"]
+#: ``RetrievalConfig.distance`` values: along the floor, or eq. 17's straight line on the grid.
+DISTANCES = ("walking", "straight")
+
+
+class FloorDistances:
+    """Walking distances (m) on a map's top-down grid from a point, or from landmark objects, to
+    every object: one Dijkstra per source, shared by all candidates, through every cell not seen
+    occupied and through the objects' own boxes (a sofa is walked around, but an object's cells
+    are where it is reached), never through walls. Results are cached per source cell."""
+
+    def __init__(self, occ: OccupancyGrid, los: NDArray[np.float64], his: NDArray[np.float64],
+                 cache_size: int = 8) -> None:
+        from capnav.language.rooms import fill_gaps
+
+        self.spec = occ.spec
+        self.los = np.asarray(los, dtype=np.float64).reshape(-1, 2)
+        self.his = np.asarray(his, dtype=np.float64).reshape(-1, 2)
+        dom = fill_gaps(occ.cells) != OCCUPIED
+        for lo, hi in zip(self.los, self.his, strict=True):
+            (r0, c0), (r1, c1) = self.spec.to_cell(lo), self.spec.to_cell(hi)
+            dom[max(r0, 0):max(r1 + 1, 0), max(c0, 0):max(c1 + 1, 0)] = True
+        self.domain = dom
+        self._cache: dict[tuple[int, ...], NDArray[np.float64]] = {}
+        self._size = cache_size
+
+    def _per_object(self, key: tuple[int, ...], los: NDArray[np.float64], his: NDArray[np.float64]
+                    ) -> NDArray[np.float64]:
+        if key in self._cache:
+            return self._cache[key]
+        from capnav.language.rooms import box_min, geodesic_from_boxes
+
+        field = geodesic_from_boxes(self.domain, self.spec, los, his, limit_m=np.inf)
+        out = np.array([box_min(field, self.spec, lo, hi) for lo, hi in zip(self.los, self.his, strict=True)])
+        if len(self._cache) >= self._size:
+            self._cache.pop(next(iter(self._cache)))
+        self._cache[key] = out
+        return out
+
+    def from_point(self, xy: tuple[float, float]) -> NDArray[np.float64]:
+        """Metres along the floor from ``xy`` to each object (inf when no walk reaches it)."""
+        p = np.asarray(xy, dtype=np.float64).reshape(1, 2)
+        rc = self.spec.to_cell(p[0])
+        return self._per_object(("point", int(rc[0]), int(rc[1])), p, p)  # type: ignore[arg-type]
+
+    def from_objects(self, idx: NDArray[np.intp]) -> NDArray[np.float64]:
+        """Metres along the floor from the nearest of the objects ``idx`` to each object."""
+        ids = tuple(int(i) for i in np.asarray(idx).ravel())
+        return self._per_object(("objects", *ids), self.los[list(ids)], self.his[list(ids)])  # type: ignore[arg-type]
+
+
+__all__ = ["DISTANCES", "MIN_ELONGATION", "FloorDistances", "end_distance", "has_long_axis", "oriented_box",
+           "segment_distance"]

@@ -66,7 +66,7 @@ class CapNavMethod(PriorMapMethod):
 def _factory(name: str, **switches: bool) -> Callable[..., NavMethod]:
     def make(planner: PlannerConfig | None = None, retrieval: RetrievalConfig | None = None,
              verifier: str = "offline", **_: object) -> NavMethod:
-        cfg = replace(retrieval or RetrievalConfig(), **switches)
+        cfg = replace(retrieval or RetrievalConfig(), **switches)  # type: ignore[arg-type]
         return CapNavMethod(name, cfg, verifier, planner)
 
     return make

@@ -1,6 +1,6 @@
-"""Distance to the robot (eq. 17): "the closest chair", "the lamp farthest from me", and a bare
-category with a robot position (the paper's attribute heuristic). It orders what no relation or
-superlative ordered (within the room, when one was named)."""
+"""Distance to the robot (along the floor, or eq. 17's straight line): "the closest chair", "the
+lamp farthest from me", and a bare category with a robot position (the paper's attribute
+heuristic). It orders what no relation or superlative ordered (within the room, when one was named)."""
 
 from __future__ import annotations
 
@@ -27,8 +27,9 @@ class Distance(RankingConstraint):
         if st.robot_xy is None:
             st.notes.append(f"'{q.proximity}' needs a robot position (--robot X,Y); ranked by similarity instead")
             return
-        d = st.r.grid_distance(st.robot_xy)[st.pool]
+        full, kind = st.r.robot_distance(st.robot_xy)
+        d = full[st.pool]
         far = q.proximity == "farthest"
         st.group_keys.append(-d if far else d)
-        st.values["distance to robot (m)"] = d
+        st.values["walking distance to robot (m)" if kind == "walking" else "distance to robot (m)"] = d
         st.predicate, st.mode = ("farthest" if far else "closest"), "closest"

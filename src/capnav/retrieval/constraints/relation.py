@@ -96,9 +96,16 @@ class Relation(RankingConstraint):
             st.group_keys.append(np.round(ends / BIN_M))
             st.predicate = f"{END_OF} the {q.anchor_category}"
         elif q.proximity_to_anchor and q.proximity is not None:
-            # "the chair closest to the table": distance to the landmark, exactly.
-            centre = np.linalg.norm(xy[pool][:, None] - xy[anchors][None], axis=2)
-            centre = np.where(same, np.inf, centre).min(axis=1)
+            # "the chair closest to the table": distance to the landmark, exactly (along the
+            # floor when the config says so: one Dijkstra from the landmarks' boxes).
+            floor = r.floor_distances()
+            walk = floor.from_objects(anchors)[pool] if floor is not None else None
+            if walk is not None and np.isfinite(walk).any():
+                centre = np.where(np.isin(pool, anchors), np.inf, np.where(np.isfinite(walk), walk, 1e6))
+                st.values["walking distance to landmark (m)"] = centre
+            else:
+                centre = np.linalg.norm(xy[pool][:, None] - xy[anchors][None], axis=2)
+                centre = np.where(same, np.inf, centre).min(axis=1)
             far = q.proximity == "farthest"
             st.group_keys.append(-centre if far else centre)
             st.predicate = f"{q.proximity} to the {q.anchor_category}"
