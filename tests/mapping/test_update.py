@@ -265,3 +265,32 @@ def test_objects_command_and_captions_of_changed_objects_only(visits: dict[str, 
     assert [r["id"] for r in h["retired"]] == rep.retired and len(h["recordings"]) == 2
     res = runner.invoke(app, ["objects", str(p), "--history"])
     assert res.exit_code == 0 and "moved from" in res.output and "gone from" in res.output
+
+
+def test_questions_about_time_answer_from_the_latest_state(visits: dict[str, Path]) -> None:
+    from capnav.language import create_captioner, create_embedder, describe_map
+    from capnav.retrieval.retriever import Retriever
+
+    m1 = load_map(visits["m1.capnav"])
+    cap, emb = create_captioner("offline"), create_embedder("minilm")
+    describe_map(m1, DatasetReader(visits["v1"]), cap, emb, progress=False)
+    m2, rep = update_map(m1, DatasetReader(visits["v2"]), _det(), _enc(), progress=False)
+    describe_map(m2, DatasetReader(visits["v2"]), cap, emb, progress=False)
+    r = Retriever(m2, emb)
+    gone = next(o for o in m2.retired)
+    res = r.query(f"where did you last see the {gone.label}")
+    assert not res.found and "last seen in recording 1" in res.reason and "no longer there" in res.reason, res.reason
+    moved = next(o for o in m2.objects if o.id == rep.moved[0])
+    res = r.query(f"the {moved.label} that was moved")
+    assert res.found and res.chosen is not None and res.chosen.id in rep.moved and "last seen in visit 2" in res.reason
+    res = r.query("what is new")
+    assert res.found and res.chosen is not None and res.chosen.id in rep.born
+    room = r._scoped["new"].scene.room_of(res.chosen)
+    if room:
+        res = r.query(f"what is new in the {room}")
+        assert res.found and res.chosen is not None and res.chosen.id in rep.born and room in res.reason
+    # without time words, the present state answers and a retired object is never returned
+    for o in m2.objects:
+        res = r.query(f"the {o.label}")
+        assert res.chosen is None or res.chosen.id not in {g.id for g in m2.retired}
+    assert not Retriever(m1, emb)._time  # a one-recording map reads requests exactly as before

@@ -10,8 +10,10 @@ until one candidate is accepted, or "not found". Every step leaves a reason in w
 
 from __future__ import annotations
 
+import re
 import time
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -26,6 +28,7 @@ from capnav.language.prompts import caption_name
 from capnav.mapping.cmap import CapNavMap
 from capnav.mapping.objects import MapObject
 from capnav.retrieval import constraints
+from capnav.retrieval import time as time_scope
 from capnav.retrieval.config import RetrievalConfig
 from capnav.retrieval.query import ParsedQuery, parse_instruction
 from capnav.retrieval.ranking import Ranking, cosine_scores
@@ -60,8 +63,11 @@ def check_map_embeddings(objects: Sequence[MapObject], embedder: TextEmbedder) -
 
 class Retriever:
     def __init__(self, cmap: CapNavMap, embedder: TextEmbedder, verifier: Verifier | None = None,
-                 config: RetrievalConfig | None = None) -> None:
+                 config: RetrievalConfig | None = None, time_aware: bool = True) -> None:
         self.cmap = cmap
+        # A map of several recordings answers about time (retrieval/time.py); its scoped retrievers do not.
+        self._time = time_aware and time_scope.has_time(cmap)
+        self._scoped: dict[str, Retriever] = {}
         self.embedder = embedder
         self.config = config or RetrievalConfig()
         check_map_embeddings(cmap.objects, embedder)
@@ -147,6 +153,10 @@ class Retriever:
             xy = np.asarray(robot_xy, dtype=np.float64)
             if xy.shape != (2,) or not np.all(np.isfinite(xy)):
                 raise InputError(f"robot position must be two finite numbers x, y, got {robot_xy!r}")
+        if self._time and isinstance(instruction, str):
+            answered = self._about_time(instruction, robot_xy)
+            if answered is not None:
+                return answered
         q = instruction if isinstance(instruction, ParsedQuery) else parse_instruction(instruction, self.embedder)
         t0 = time.perf_counter()
         e_q = self.embedder.embed([q.text])[0]
@@ -197,6 +207,63 @@ class Retriever:
                            [(self.objects[i], sc) for i, sc, _, _ in runners], predicate, reason, timings,
                            mode, dist, q.to_dict(), [{"terms": t, "why": w} for _, _, t, w in runners],
                            judged[chosen_i].terms if chosen_i in judged else {})
+
+    def _about_time(self, instruction: str, robot_xy: tuple[float, float] | None) -> QueryResult | None:
+        """Time words narrow the objects; a best match that is retired is "not found" (when last seen).
+        None: answer from the present objects as usual."""
+        scope = time_scope.read_time(instruction)
+        if scope is None and not self.cmap.retired:
+            return None
+        key = scope.kind if scope is not None else "all"
+        if key not in self._scoped:
+            sub_map, _ = time_scope.scoped_map(self.cmap, scope)
+            if not sub_map.objects:
+                why = {"moved": "no object has moved between the recordings",
+                       "new": "no object is new in the latest recording"}.get(key, "the map has no objects")
+                return QueryResult(instruction, None, False, 0.0, [], None, why)
+            self._scoped[key] = Retriever(sub_map, self.embedder, self.verifier, self.config, time_aware=False)
+        sub = self._scoped[key]
+        if scope is not None and scope.kind in ("moved", "new"):
+            listed = self._list_changed(sub, scope, robot_xy)
+            if listed is not None:
+                return listed
+        res = sub.query(scope.text if scope is not None else instruction, robot_xy)
+        gone = {o.id for o in self.cmap.retired}
+        if res.chosen is not None and res.chosen.id in gone:
+            return replace(res, chosen=None, found=False, score=0.0, distance_m=None, terms={},
+                           reason=time_scope.gone_reason(res.chosen, self.cmap))
+        if scope is None:
+            return None
+        if res.chosen is not None:
+            res = replace(res, reason=f"{res.reason}; {time_scope.when_seen(res.chosen, self.cmap)}")
+        return res
+
+    @staticmethod
+    def _list_changed(sub: Retriever, scope: time_scope.TimeScope, robot_xy: tuple[float, float] | None
+                      ) -> QueryResult | None:
+        """"What is new (in the kitchen)": no object named, so every changed object (in that room)
+        answers; the nearest to the robot (else the lowest id) is the goal. None when one is named."""
+        words = re.findall(r"[a-z]+", scope.text.lower())
+        rooms = {r for r in sub.scene.rooms if r}
+        room = next((r for r in rooms if re.search(rf"\b{re.escape(r)}\b", scope.text.lower())), None)
+        rest = [w for w in words if w not in {"something", "anything", "thing", "things", "in", "the", "a", "an", "on",
+                                              "at", "near", "by", "object", "objects"}
+                and not (room and w in room.split())]
+        if rest:
+            return None
+        idx = [i for i, o in enumerate(sub.objects) if room is None or sub.scene.rooms[i] == room]
+        if not idx:
+            return QueryResult(scope.text, None, False, 0.0, [], "room", f"nothing {scope.kind} in the {room}")
+        if robot_xy is not None:
+            d = sub.grid_distance(robot_xy)
+            idx.sort(key=lambda i: (float(d[i]), sub.objects[i].id))
+        best = sub.objects[idx[0]]
+        what = ", ".join(f"{sub.objects[i].label} {sub.objects[i].id}" for i in idx)
+        where = f" in the {room}" if room else ""
+        reason = f"{scope.kind}{where}: {what}; the goal is the {best.label} {best.id}" + (
+            " (nearest)" if robot_xy is not None and len(idx) > 1 else "")
+        return QueryResult(scope.text, best, True, 1.0, [(sub.objects[i], 1.0) for i in idx[1:]],
+                           "room" if room else None, reason, mode="history")
 
     def _final(self, rk: Ranking, judged: dict[int, Assessment]) -> list[int]:
         """Every ranked candidate in the order the decision considered them: by predicate group,
