@@ -93,6 +93,7 @@ def test_what_is_kept_reaches_the_storage_furniture(emb):
     ("where can the children eat their lunch", "eat their lunch"),
     ("I fancy cooking an omelette", "cooking an omelette"),
     ("where could my guests hang their coats", "hang their coats"),
+    ("I'd like to rest a moment, is there anything to lean on near the window", "lean on"),
 ])
 def test_an_activity_with_any_subject_or_a_wish(text, activity):
     assert find_activity(text) == activity

@@ -47,8 +47,8 @@ def retriever(emb):
 
 def test_every_kind_is_registered_by_its_module():
     kinds = {c.kind for c in RANKING} | {c.kind for c in ATTRIBUTES}
-    assert {"category", "negation", "room", "relation", "superlative", "distance", "ordinal",
-            "colour", "size", "shape", "material"} <= kinds
+    assert {"category", "detectable", "negation", "room", "relation", "superlative", "distance", "ordinal",
+            "purpose", "colour", "size", "shape", "material"} <= kinds
     orders = [c.order for c in RANKING]
     assert orders == sorted(orders)
 
@@ -120,3 +120,10 @@ def test_a_new_kind_is_one_registered_class(retriever):
     finally:
         RANKING.remove(FarFromOrigin)
     assert retriever.query("the armchair yonder").predicate != "yonder"
+
+
+def test_a_purpose_says_the_order_of_fit_in_the_reason(retriever, emb):
+    q = parse_instruction("where could I have a nap", emb)
+    res = retriever.query(q)
+    assert res.found and res.chosen.label == "bed"
+    assert f"'{q.purpose}' is served best by bed" in res.reason

@@ -39,7 +39,7 @@ from capnav.language.lexicon import Lexicon, load_lexicon
 #: A purpose clause: "somewhere (comfy) to X", "a place where I can X", "where can I X",
 #: "I need to X", "something to X on". The activity is group ``act``.
 _PURPOSE = [
-    re.compile(r"\b(?:somewhere|someplace|some place|anywhere|a place|a spot|a surface|something|a thing)"
+    re.compile(r"\b(?:somewhere|someplace|some place|anywhere|a place|a spot|a surface|something|anything|a thing)"
                r"(?:\s+\w+)?\s+(?:where\s+)?(?:(?:i|we|you|one)\s+(?:can|could|might|may)|to|for\s+(?:me\s+)?to"
                r"|for|that\s+i\s+can)\s+(?P<act>.+)"),
     re.compile(r"\bwhere\s+(?:can|could|do|should|might|would|may)\s+(?:i|we|one|you|(?:the|my|our|your|his|her|"

@@ -1,0 +1,27 @@
+"""A request by purpose ("somewhere to put my feet up"): the categories that serve the activity,
+best fit first (``language.purpose``: the furniture made for it before what merely allows it),
+are the category tiers; this constraint says the order in the reason and leaves a purpose whose
+best category is absent to the ones after it."""
+
+from __future__ import annotations
+
+from capnav.retrieval.constraints.base import RankingConstraint, RankState, ranking
+from capnav.retrieval.query import ParsedQuery
+
+
+@ranking
+class Purpose(RankingConstraint):
+    kind = "purpose"
+    order = 12  # after the category set the tiers up
+
+    @staticmethod
+    def applies(q: ParsedQuery) -> bool:
+        return q.purpose is not None and q.category is not None
+
+    def rank(self, st: RankState) -> None:
+        q, r = st.q, st.r
+        present = {r.cats[int(i)] for i in st.pool}
+        fit = [(1.0, str(q.category)), *sorted(((w, c) for c, w in q.category_alternatives.items()), reverse=True)]
+        served = [f"{c}" + ("" if w >= 1.0 else f" ({w:.2f})") for w, c in fit if c in present]
+        if served:
+            st.notes.append(f"'{q.purpose}' is served best by {', then '.join(served[:4])}")
