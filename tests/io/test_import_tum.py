@@ -196,3 +196,13 @@ def test_cli(tmp_path: Path, frames: list[Frame]) -> None:
     assert res.exit_code != 0 and "--up +z contradicts the recording" in str(res.exception)
     assert len(DatasetReader(tmp_path / "ds")) == 2  # the dataset already there is kept
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
+
+
+def test_negative_max_pose_gap_is_refused(tmp_path: Path, frames: list[Frame]) -> None:
+    write_tum(tmp_path / "seq", frames[:2])
+    for bad in (-0.5, float("nan")):
+        with pytest.raises(InputError, match=r"--max-pose-gap must be a number of seconds >= 0"):
+            TumReader(tmp_path / "seq", max_pose_gap=bad)
+    res = CliRunner().invoke(app, ["import", "tum", str(tmp_path / "seq"), "-o", str(tmp_path / "ds"),
+                                   "--max-pose-gap", "-1", "--no-progress"])
+    assert res.exit_code != 0 and "--max-pose-gap must be" in str(res.exception)

@@ -1,13 +1,13 @@
 """Do the poses and the depth of a recording agree? A check between neighbouring frames.
 
 A wrong pose convention (world-to-camera read as camera-to-world, OpenGL camera axes read as
-OpenCV) or a wrong depth scale gives a dataset that imports without complaint and maps into
-garbage. Neighbouring frames see the same surfaces, so frame a's depth, lifted with its pose and
-projected into frame b with b's pose, must land on b's depth. The share of points that do (within
-3 cm or 3 %) is measured for the poses as read and for each other reading; when another reading
-fits far better, the import is refused with the reason. Pairs are taken a little apart in motion
-(a few centimetres or degrees), so the readings differ; a recording whose cameras hardly move, or
-whose neighbours do not overlap, is not judged.
+OpenCV, a robot body's pose read as the camera's) or a wrong depth scale gives a dataset that
+imports without complaint and maps into garbage. Neighbouring frames see the same surfaces, so
+frame a's depth, lifted with its pose and projected into frame b with b's pose, must land on b's
+depth. The share of points that do (within 3 cm or 3 %) is measured for the poses as read and for
+each other reading; when another reading fits far better, the import is refused with the reason.
+Pairs are taken a little apart in motion (a few centimetres or degrees), so the readings differ;
+a recording whose cameras hardly move, or whose neighbours do not overlap, is not judged.
 """
 
 from __future__ import annotations
@@ -24,19 +24,39 @@ from capnav.core.geometry import Intrinsics
 F64 = NDArray[np.float64]
 GL = np.diag([1.0, -1.0, -1.0, 1.0])
 
-#: Readings of the recorded poses and depth tried besides "as recorded": a name, what it means to
-#: the user, and how it turns (pose, depth) into the poses and depth that would then be true.
-READINGS: dict[str, tuple[str, Callable[[F64], F64], float]] = {
-    "as recorded": ("", lambda T: T, 1.0),
-    "world-to-camera": ("the poses are world-to-camera (inverse) matrices, not camera-to-world",
-                        lambda T: np.asarray(np.linalg.inv(T), dtype=np.float64), 1.0),
-    "OpenGL camera": ("the poses use OpenGL camera axes (y up, z backwards), not OpenCV's (y down, z forward)",
-                      lambda T: np.asarray(T @ GL, dtype=np.float64), 1.0),
-    "depth x5": ("the depth is 5 times too small: is --depth-scale 5 times too big (5000 read for millimetre PNGs)?",
-                 lambda T: T, 5.0),
-    "depth /5": ("the depth is 5 times too large: is --depth-scale 5 times too small (1000 read for TUM's 5000)?",
-                 lambda T: T, 0.2),
-}
+#: A ROS body frame (x forward, y left, z up) -> the optical frame of a camera at its origin looking
+#: along x (optical z = body x, x = -body y, y = -body z); quaternion (x, y, z, w) = (0.5, -0.5, 0.5, -0.5).
+BODY_TO_OPTICAL = np.array([[0.0, 0.0, 1.0, 0.0], [-1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
+
+
+@dataclass(frozen=True)
+class Reading:
+    """One way of reading a recording's poses and depth: what it means, and how it turns the recorded
+    (pose, depth) into the ones that would then be true."""
+
+    name: str
+    meaning: str
+    pose: Callable[[F64], F64]
+    depth_factor: float = 1.0
+    remedy: str = ""
+
+
+READINGS: tuple[Reading, ...] = (
+    Reading("as recorded", "", lambda T: T),
+    Reading("world-to-camera", "the poses are world-to-camera (inverse) matrices, not camera-to-world",
+            lambda T: np.asarray(np.linalg.inv(T), dtype=np.float64), remedy="invert them"),
+    Reading("OpenGL camera", "the poses use OpenGL camera axes (y up, z backwards), not OpenCV's (y down, z forward)",
+            lambda T: np.asarray(T @ GL, dtype=np.float64),
+            remedy="turn them by diag(1, -1, -1) (capnav import stray: --camera-axes opengl)"),
+    Reading("body frame", "the poses are of a body frame (x forward, z up, as ROS odometry), not the camera's "
+            "optical frame", lambda T: np.asarray(T @ BODY_TO_OPTICAL, dtype=np.float64),
+            remedy="pass --camera-in-body x,y,z,qx,qy,qz,qw, the optical frame in the body frame "
+                   "(0,0,0,0.5,-0.5,0.5,-0.5 for a camera at the body's origin looking along its x)"),
+    Reading("depth x5", "the depth is 5 times too small: is --depth-scale 5 times too big (5000 read for "
+            "millimetre PNGs)?", lambda T: T, 5.0),
+    Reading("depth /5", "the depth is 5 times too large: is --depth-scale 5 times too small (1000 read for "
+            "TUM's 5000)?", lambda T: T, 0.2),
+)
 
 
 @dataclass
@@ -115,20 +135,22 @@ def check(depths: list[NDArray[np.floating]], poses: list[F64], K: Intrinsics, s
     if res.pairs == 0:
         res.reason = "no neighbouring frames moved a few centimetres or degrees apart"
         return res
-    for name, (_, fix, s) in READINGS.items():
+    for rd in READINGS:
         vals = []
         for k in range(res.pairs):
-            da, db = depths[2 * k] * s, depths[2 * k + 1] * s
-            a, m = agreement(da, fix(poses[2 * k]), db, fix(poses[2 * k + 1]), K, rng)
+            da, db = depths[2 * k] * rd.depth_factor, depths[2 * k + 1] * rd.depth_factor
+            a, m = agreement(da, rd.pose(poses[2 * k]), db, rd.pose(poses[2 * k + 1]), K, rng)
             if m >= 50:
                 vals.append(a)
-        res.agreement[name] = float(np.median(vals)) if vals else 0.0
+        res.agreement[rd.name] = float(np.median(vals)) if vals else 0.0
     given = res.agreement["as recorded"]
-    alt, best = max(((k, v) for k, v in res.agreement.items() if k != "as recorded"), key=lambda kv: kv[1])
+    alt = max(READINGS[1:], key=lambda rd: res.agreement[rd.name])
+    best = res.agreement[alt.name]
     if best >= min_agreement and best > given + margin:
         res.verdict = "refused"
-        res.reason = (f"{READINGS[alt][0]}: neighbouring frames' depth agrees on {100 * best:.0f}% of the points "
-                      f"read that way, {100 * given:.0f}% as recorded ({res.pairs} frame pairs)")
+        res.reason = (f"{alt.meaning}: neighbouring frames' depth agrees on {100 * best:.0f}% of the points "
+                      f"read that way, {100 * given:.0f}% as recorded ({res.pairs} frame pairs)"
+                      + (f"; {alt.remedy}" if alt.remedy else ""))
     elif given >= min_agreement:
         res.verdict = "consistent"
         res.reason = f"neighbouring frames' depth agrees on {100 * given:.0f}% of the points ({res.pairs} pairs)"

@@ -23,7 +23,7 @@ from capnav.core.geometry import Intrinsics
 from capnav.core.progress import track
 from capnav.io.align import Alignment, floor_alignment
 from capnav.io.assoc import SkipLog
-from capnav.io.consistency import Consistency, check, pair_up
+from capnav.io.consistency import READINGS, Consistency, check, pair_up
 from capnav.io.up_axis import CUES, UpConfig
 
 
@@ -113,6 +113,24 @@ def select(frames: list[PlannedFrame], stride: int = 1, max_frames: int | None =
     return frames[::stride][:max_frames]
 
 
+def other_reading(views: list[tuple[NDArray[np.float32], NDArray[np.float64]]], poses: NDArray[np.float64],
+                  K: Intrinsics, floor: UpConfig | None) -> str:
+    """When up cannot be found as the poses are read: the other pose reading (``capnav.io.consistency``)
+    under which it is found with confidence, as words for the error, or ''."""
+    for rd in READINGS[1:]:
+        if rd.depth_factor != 1.0:
+            continue
+        try:
+            a = floor_alignment([(d, rd.pose(T)) for d, T in views], K, "auto", floor,
+                                poses=np.stack([rd.pose(T) for T in poses]))
+        except InputError:
+            continue
+        return (f"{rd.meaning}: read that way, up is found (confidence {a.info['confidence']:.2f}, cameras "
+                f"{a.info['facts']['camera_height_median_m']:.2f} m above the floor), as read it is not"
+                + (f"; {rd.remedy}" if rd.remedy else ""))
+    return ""
+
+
 def check_poses(rec: Recording, frames: list[PlannedFrame], shape: tuple[int, int]) -> Consistency:
     """The reprojection check of ``capnav.io.consistency`` on neighbouring selected frames."""
     pairs = pair_up([f.T_wc for f in frames])
@@ -141,8 +159,15 @@ def import_recording(rec: Recording, out: str | Path, up: str = "auto", stride: 
     if consistency.verdict == "refused":
         raise InputError(f"{rec.path}: the poses and the depth do not fit together as read; {consistency.reason}")
     pick = np.unique(np.round(np.linspace(0, len(frames) - 1, min(align_frames, len(frames)))).astype(int))
-    views = ((d, f.T_wc) for f, d in rec.load_depths([frames[i] for i in pick]) if d.shape == shape)
-    align = floor_alignment(views, rec.K, up, floor, poses=np.stack([f.T_wc for f in frames]))
+    views = [(d, f.T_wc) for f, d in rec.load_depths([frames[i] for i in pick]) if d.shape == shape]
+    poses = np.stack([f.T_wc for f in frames])
+    try:
+        align = floor_alignment(views, rec.K, up, floor, poses=poses)
+    except InputError as e:
+        hint = other_reading(views, poses, rec.K, floor)
+        if not hint:
+            raise
+        raise InputError(f"{rec.path}: {hint} (as the poses are read: {e})") from None
 
     skipped = SkipLog(list(rec.skipped.skips))
     n_before = len(rec.skipped.skips)  # the reader counts frames it cannot load while they are written

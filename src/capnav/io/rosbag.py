@@ -116,6 +116,41 @@ def _rows(msg: Any, dtype: np.dtype[Any], ch: int, where: str) -> NDArray[Any]:
     return np.ascontiguousarray(rows).view(dtype).reshape(h, w, ch)
 
 
+#: How each bag storage begins (ROS1 bag, ROS2 sqlite3 and MCAP storage files).
+BAG_MAGIC = {b"#ROSBAG V2.0": "a ROS1 bag", b"SQLite format 3\x00": "a ROS2 sqlite3 file",
+             b"\x89MCAP": "an MCAP file"}
+OTHER_MAGIC = {b"\x89PNG": "a PNG image", b"\xff\xd8\xff": "a JPEG image", b"PK\x03\x04": "a zip archive",
+               b"\x1f\x8b": "a gzip file", b"%PDF": "a PDF", b"\x00\x00\x00": "an MP4 / QuickTime video"}
+
+
+def check_is_bag(path: Path) -> None:
+    """Refuse, naming what it is instead, a file that is not a bag (the bag library would fail on it with a
+    decoding error that says nothing) or a folder that is not a ROS2 bag."""
+    if path.is_dir():
+        if not (path / "metadata.yaml").is_file():
+            raise InputError(f"{path} is a folder but not a ROS2 bag (no metadata.yaml); a ROS1 bag is one .bag file")
+        return
+    try:
+        with path.open("rb") as fh:
+            head = fh.read(64)
+    except OSError as e:
+        raise InputError(f"cannot read {path}: {e.strerror or e}") from None
+    if any(head.startswith(m) for m in BAG_MAGIC):
+        return
+    what = next((v for m, v in OTHER_MAGIC.items() if head.startswith(m)), None)
+    if what is None:
+        if not head:
+            what = "an empty file"
+        else:
+            try:
+                head.decode("utf-8")
+                what = f"text ({head[:30].decode('utf-8', 'replace')!r}...)"
+            except UnicodeDecodeError:
+                what = f"binary data starting {head[:8].hex(' ')}"
+    raise InputError(f"{path} is not a ROS bag: it is {what}; a ROS1 bag begins with '#ROSBAG V2.0', a ROS2 bag "
+                     "is a folder with metadata.yaml")
+
+
 class RosbagReader:
     """A ROS1/ROS2 bag as associated frames (``frames``) plus the colour images dropped (``skipped``)."""
 
@@ -198,6 +233,7 @@ class RosbagReader:
     def _open(self) -> Iterator[Any]:
         """The opened ``AnyReader``; the library's errors (corrupt bag, missing types) become ``InputError``."""
         highlevel = _rosbags()
+        check_is_bag(self.path)
         from rosbags.typesys import Stores, get_typestore
 
         path = self.path.parent if self.path.is_file() and self.path.suffix in (".db3", ".mcap") else self.path
