@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from capnav.core.errors import InputError
+from capnav.core.errors import InputError, pip_hint
 from capnav.core.geometry import Intrinsics
 from capnav.io.assoc import poses_from_quat
 from capnav.io.consistency import GL
@@ -194,6 +194,6 @@ def _cv2() -> Any:
     try:
         import cv2
     except ImportError:
-        raise InputError("reading rgb.mp4 needs OpenCV: pip install 'capnav[coco]' (or opencv-python-headless), "
+        raise InputError(f"reading rgb.mp4 needs OpenCV: {pip_hint('capnav[coco]')} (or opencv-python-headless), "
                          "or extract the video to SRC/rgb/000000.png ...") from None
     return cv2

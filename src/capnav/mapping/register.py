@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from capnav.core.errors import InputError
+from capnav.core.errors import InputError, pip_hint
 from capnav.core.frame import Frame
 
 
@@ -73,7 +73,7 @@ def _o3d() -> Any:
     try:
         import open3d as o3d
     except (ImportError, OSError):  # not installed, or a system library it needs (libusb) is missing
-        raise InputError("registering two recordings needs Open3D (pip install 'capnav[register]'); or give "
+        raise InputError(f"registering two recordings needs Open3D ({pip_hint('capnav[register]')}); or give "
                          "the transform with --transform, or --same-frame when both share a world frame") from None
     return o3d
 

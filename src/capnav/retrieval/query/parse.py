@@ -23,6 +23,7 @@ import threading
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from capnav.core.errors import pip_hint
 from capnav.language.context import ROOM_SYNONYMS
 from capnav.language.purpose import find_activity
 from capnav.retrieval.query.tokens import _FORM_MAP, _find_category, attribute_word
@@ -181,7 +182,7 @@ def analyse(text: str, use_parser: bool | None = None) -> list[GoalParse]:
     nlp = load_parser() if want else None
     if nlp is None:
         note = [] if not want else [f"read by word patterns: {_WHY_NOT[0] if _WHY_NOT else 'no parser'} "
-                                    "(pip install 'capnav[parse]')"]
+                                    f"({pip_hint('capnav[parse]')})"]
         return [GoalParse(g, g, notes=list(note)) for g in goals]
     name = f"spacy {nlp.meta.get('name', '?')} {nlp.meta.get('version', '?')}"
     out = []
