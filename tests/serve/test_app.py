@@ -30,6 +30,9 @@ def test_page_and_static_files(client: TestClient) -> None:
 
 def test_map_objects_and_health(client: TestClient) -> None:
     assert client.get("/healthz").json() == {"ok": True, "objects": 7}
+    ready = client.get("/readyz")
+    assert ready.status_code == 200 and ready.json()["ready"] and ready.json()["maps"][0]["name"] == "living"
+    assert client.get("/api/maps").json()["default"] == "living"
     m = client.get("/api/map").json()
     assert m["grid"]["resolution"] == 0.05 and m["objects"] == 7 and m["captioned"]
     pic = m["picture"]

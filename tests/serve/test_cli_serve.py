@@ -109,3 +109,15 @@ def test_query_robot_is_checked_against_the_map(served_map: Path) -> None:
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
     assert d["chosen"]["id"] == 1 and "inside an obstacle; moved" in d["robot_note"]
+
+
+def test_query_refuses_a_map_with_zero_embeddings(served_map: Path, tmp_path: Path) -> None:
+    import numpy as np
+
+    cmap = load_map(served_map)
+    for o in cmap.objects:
+        o.embedding = np.zeros_like(np.asarray(o.embedding))
+    bad = save_map(cmap, tmp_path / "zero.capnav")
+    r = subprocess.run([sys.executable, "-m", "capnav.cli", "query", str(bad), "the red sofa"], capture_output=True,
+                       text=True, timeout=120)
+    assert r.returncode == 2 and "all-zero caption embeddings" in r.stderr and len(r.stderr.strip().splitlines()) == 1

@@ -60,6 +60,9 @@ def register(app: typer.Typer) -> None:
             from capnav.retrieval.sequence import query_goals
 
             cmap = load_map(map_path, voxels=False)  # retrieval reads objects and occupancy only
+            from capnav.mapping.embeddings import check_embeddings
+
+            check_embeddings(cmap, str(map_path))  # all-zero or non-unit vectors: refused, not answered 0.000
             if embedder == "auto":
                 models = {o.embedding_model for o in cmap.objects if o.embedding_model}
                 if not models:

@@ -22,10 +22,9 @@ from capnav.core.errors import CapNavError, InputError
 from capnav.core.grid import FREE
 from capnav.language.embedder import TextEmbedder
 from capnav.mapping.cmap import CapNavMap
+from capnav.mapping.embeddings import check_embeddings
 from capnav.viz.mapimage import MapPicture, map_picture
 
-#: How far a stored caption embedding's length may be from 1 (they are saved as float32 unit vectors).
-UNIT_TOLERANCE = 1e-3
 _NAME = re.compile(r"[^A-Za-z0-9_.-]+")
 
 
@@ -42,27 +41,6 @@ class AskOptions:
     def shared_instance(self) -> bool:
         """A ready embedder object: every worker would share it, so the pool runs one worker."""
         return isinstance(self.embedder, TextEmbedder)
-
-
-def check_embeddings(cmap: CapNavMap, where: str) -> None:
-    """Refuse a map whose caption embeddings cannot be searched: all zero, or not unit length (a
-    map written by other code, or damaged in a way its checksums do not see)."""
-    bad_zero, bad_len = [], []
-    for o in cmap.objects:
-        if o.embedding is None:
-            continue
-        n = float(np.linalg.norm(np.asarray(o.embedding, dtype=np.float64)))
-        if not np.isfinite(n) or n == 0.0:
-            bad_zero.append(o.id)
-        elif abs(n - 1.0) > UNIT_TOLERANCE:
-            bad_len.append((o.id, n))
-    if bad_zero:
-        raise InputError(f"{where}: {len(bad_zero)} objects have all-zero caption embeddings (ids {bad_zero[:10]}); "
-                         "every similarity would be 0: re-run `capnav caption` on this map")
-    if bad_len:
-        ids = [i for i, _ in bad_len[:10]]
-        raise InputError(f"{where}: {len(bad_len)} caption embeddings are not unit vectors (ids {ids}, lengths "
-                         f"{', '.join(f'{n:.3f}' for _, n in bad_len[:3])}); re-run `capnav caption` on this map")
 
 
 def default_robot(nav: CapNav) -> tuple[float, float] | None:
