@@ -132,3 +132,26 @@ def test_the_checker_sees_lazy_and_type_checking_imports() -> None:
     assert "capnav.language" in GRAPH["capnav.pipeline.simulated"]  # inside a function
     assert "capnav.sim.config" in GRAPH["capnav.sim.agent"]  # under TYPE_CHECKING
     assert "capnav.eval.generate" in GRAPH["capnav.eval.pipeline"]
+
+
+#: What a user runs to navigate: none of it may reach the evaluation, directly or through another module.
+NAVIGATING = ("capnav.cli.navigate", "capnav.api", "capnav.serve", "capnav.pipeline.drive")
+
+
+def test_navigating_never_reaches_the_evaluation() -> None:
+    bad = []
+    for root in (m for m in MODULES if m.startswith(NAVIGATING)):
+        seen, todo, via = {root}, [root], {root: root}
+        while todo:
+            v = todo.pop()
+            for w in GRAPH[v]:
+                if w not in seen:
+                    seen.add(w)
+                    via[w] = v
+                    todo.append(w)
+        for w in sorted(m for m in seen if layer(m) == "eval"):
+            chain = [w]
+            while chain[-1] != root:
+                chain.append(via[chain[-1]])
+            bad.append(" <- ".join(chain))
+    assert not bad, "navigation reaches the evaluation:\n" + "\n".join(bad)

@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from capnav.core.errors import DatasetError, InputError
-from capnav.eval.drive import episode_start, parse_pose
 from capnav.eval.episodes import Episode, EpisodeSet, StartPose, Subgoal
+from capnav.pipeline.drive import episode_start, parse_pose
 
 
 def test_parse_pose() -> None:

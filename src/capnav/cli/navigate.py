@@ -24,8 +24,8 @@ def register(app: typer.Typer) -> None:
         instruction: Annotated[str, typer.Argument(help='what to go to, e.g. "the white sofa with curved arms"')],
         scene: Annotated[int | None, typer.Option(
             "--scene", help="apartment seed to drive in (default: the seed recorded in the map)")] = None,
-        start: Annotated[str | None, typer.Option(help="start pose X,Y[,YAW] (m, rad); default: the recording's "
-                                                       "last camera pose, or seeded random in the simulator")
+        start: Annotated[str | None, typer.Option(help="start pose X,Y[,YAW] (m, rad); default: the map's last "
+                                                       "camera pose (seeded random for a map without one)")
                          ] = None,
         drive: Annotated[bool | None, typer.Option(
             "--drive/--plan-only", help="drive the simulated agent (default when the map comes from capnav sim) or "
@@ -57,10 +57,10 @@ def register(app: typer.Typer) -> None:
         from capnav.cli.options import check_map_scene, check_model_folder, check_output_dir, check_verifier
         from capnav.core.console import make_console
         from capnav.core.errors import InputError
-        from capnav.eval.drive import OCCUPANCY_KINDS, episode_start, parse_pose
         from capnav.io.mapfile import load_map
         from capnav.language import create_embedder
         from capnav.language.embedder import EMBEDDERS
+        from capnav.pipeline.drive import OCCUPANCY_KINDS, episode_start, parse_pose
         from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
 
         if occupancy not in OCCUPANCY_KINDS:  # fail before the slow loading below
@@ -98,13 +98,18 @@ def register(app: typer.Typer) -> None:
             else:
                 _plan_legs(con, cmap, retriever, goals, given, out, through_unknown)
             return
-        from capnav.eval.drive import random_start, run_instruction
         from capnav.io.rosmap import write_ros_map
+        from capnav.pipeline.drive import random_start, run_instruction
         from capnav.sim import Simulator
 
         legs = []
         stopped = ""
         with Simulator.from_seed(int(scene_seed)) as sim:
+            if given is None and cmap.trajectory is not None and len(cmap.trajectory):
+                from capnav.planning.on_map import camera_start
+
+                given, where = camera_start(cmap.trajectory)
+                con.print(f"start: {where}", highlight=False)
             pose = given or random_start(sim, seed)
             agent = sim.spawn_agent(*pose)
             for k, goal in enumerate(goals):

@@ -24,11 +24,11 @@ from capnav.core.grid import FREE
 from capnav.core.limits import check_count, check_image_size
 from capnav.core.text import shorten
 from capnav.demo.report import Report, ReportItem, verdict, write_html, write_markdown
-from capnav.eval.drive import run_instruction
 from capnav.eval.generate import SceneTruth, start_cells
 from capnav.eval.success import SUCCESS_RADIUS_M, distance_to_instances
 from capnav.mapping.objects import MapObject
 from capnav.pipeline import PipelineConfig, SimScene, open_sim_scene
+from capnav.pipeline.drive import run_instruction
 from capnav.planning import PlannerConfig
 from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
 

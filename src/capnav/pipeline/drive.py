@@ -1,6 +1,7 @@
 """One instruction end to end in the simulator: retrieve the described object, plan to it, drive
-the simulated agent there, draw it (``capnav navigate`` and the demo). It lives beside the
-evaluation because it drives the simulator and reads episode files; the stages it calls do not.
+the simulated agent there, draw it (``capnav navigate`` and the demo). It is the product's motion
+side, not the benchmark's: it never imports the evaluation (an episode file is read as the JSON
+it is, for its start pose only).
 
 The pipeline sees the map only; the simulator is the world the agent drives in (its obstacles
 are read only when the caller asks to plan on the true occupancy, for comparison).
@@ -14,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from capnav.core.errors import InputError
+from capnav.core.errors import DatasetError, InputError
 from capnav.core.grid import OccupancyGrid
 from capnav.planning.config import PlannerConfig
 from capnav.planning.execute import NavResult, navigate_to
@@ -63,19 +64,28 @@ def parse_pose(text: str) -> tuple[float, float, float]:
 
 def episode_start(path: str | Path, episode_id: str | None = None) -> tuple[int, tuple[float, float, float]]:
     """Scene seed and start pose of an episode of an episode file (the first when no id is given)."""
-    from capnav.eval.episodes import EpisodeSet
+    from capnav.core.jsonfile import read_json_object
 
-    eps = EpisodeSet.load(path).episodes
-    if not eps:
+    data = read_json_object(Path(path), "episode file")
+    if data.get("format") != "capnav-episodes":
+        raise DatasetError(f"{path} is not a CapNav episode file (format {data.get('format')!r})")
+    eps = data.get("episodes")
+    if not isinstance(eps, list) or not eps:
         raise InputError(f"{path} holds no episodes")
-    match = [e for e in eps if episode_id is None or e.id == episode_id]
+    match = [e for e in eps if isinstance(e, dict) and (episode_id is None or e.get("id") == episode_id)]
     if not match:
-        ids = ", ".join(e.id for e in eps[:8])
+        ids = ", ".join(str(e.get("id")) for e in eps[:8] if isinstance(e, dict))
         raise InputError(f"no episode {episode_id!r} in {path} (first ids: {ids})")
     e = match[0]
-    if e.start is None:
-        raise InputError(f"episode {e.id} of {path} has no start pose; give --start X,Y,YAW")
-    return e.scene_seed, (e.start.x, e.start.y, e.start.yaw)
+    s = e.get("start")
+    if not isinstance(s, dict):
+        raise InputError(f"episode {e.get('id')} of {path} has no start pose; give --start X,Y,YAW")
+    try:
+        pose = (float(s["x"]), float(s["y"]), float(s.get("yaw", 0.0)))
+        seed = int(e["scene_seed"])
+    except (KeyError, TypeError, ValueError) as err:
+        raise DatasetError(f"episode {e.get('id')} of {path}: bad start or scene_seed ({err})") from None
+    return seed, pose
 
 
 def random_start(sim: Simulator, seed: int) -> tuple[float, float, float]:
