@@ -66,6 +66,11 @@ is spoken to):
   that occurs in lower case in its sense-tagged corpus (``cntlist``; "LA" the state does not make
   "la" English); they mark an instruction as not English (``capnav.retrieval.query`` says when).
 
+- ``labels``: surface form -> detector class, for the classes a closed-set detector gives that are
+  not CapNav categories (``LABEL_ROOTS``: COCO's cup, bottle, book, laptop, cell phone, ...), so
+  that every indoor class is reachable by its everyday names ("mug", "rucksack", "mobile phone",
+  "paperback"), chosen like the categories' forms.
+
 WordNet's licence notice is copied beside the data (``WORDNET_LICENSE``).
 """
 
@@ -168,8 +173,69 @@ def build(wordnet: Path) -> dict[str, Any]:
         out = _build(wn)
         out["sizes"] = _sizes(wn, (wordnet / "adj.exc").read_text().splitlines())
         out["growth"] = _growth(wn, out["forms"])
+        out["labels"] = _labels(wn, out["forms"])
         out["forms"] = dict(sorted(out["forms"].items()))
         return out
+
+
+#: The detector classes that are not CapNav categories (COCO's indoor things kept under their own
+#: name, ``capnav.perception.coco.KEPT_AS_IS``) and the WordNet synsets each one is: their lemmas
+#: and their hyponyms' lemmas are the everyday names that reach the class ("rucksack", "mobile
+#: phone", "microwave oven", "paperback"). A mug (``mug.n.04``) is not under ``cup.n.01`` in
+#: WordNet, but COCO's "cup" is the class a detector gives a mug, so it is a root of the cup too.
+LABEL_ROOTS: dict[str, list[str]] = {
+    "bench": ["bench.n.01"], "backpack": ["backpack.n.01"], "umbrella": ["umbrella.n.01"], "handbag": ["bag.n.04"],
+    "suitcase": ["bag.n.06"], "bottle": ["bottle.n.01"], "wine glass": ["wineglass.n.01"],
+    "cup": ["cup.n.01", "mug.n.04"], "bowl": ["bowl.n.03", "bowl.n.01"], "laptop": ["laptop.n.01"],
+    "mouse": ["mouse.n.04"], "remote": ["remote_control.n.01"], "keyboard": ["keyboard.n.01"],
+    "cell phone": ["cellular_telephone.n.01"], "microwave": ["microwave.n.02"], "toaster": ["toaster.n.02"],
+    "book": ["book.n.02"], "clock": ["clock.n.01"], "vase": ["vase.n.01"], "scissors": ["scissors.n.01"],
+    "teddy bear": ["teddy.n.01"], "hair drier": ["hand_blower.n.01"], "toothbrush": ["toothbrush.n.01"],
+}
+
+
+def _labels(wn: Any, forms: dict[str, str]) -> dict[str, str]:
+    """Surface form -> detector class for the classes of ``LABEL_ROOTS``, chosen like the
+    categories' forms: a lemma counts when its most frequent physical sense lies under the class
+    and it is not a category's form, a colour or a room word (the category table wins: "settee"
+    stays a sofa although WordNet files it under bench; "toilet bowl", with a category's own word
+    in it, is left to that category)."""
+    colour_words = set(LEXICON) | set(ALIASES)
+    owner: dict[str, str] = {}
+    for label, roots in LABEL_ROOTS.items():
+        for n in roots:
+            s = wn.synset(n)
+            for x in [s, *s.closure(lambda y: y.hyponyms())]:
+                owner.setdefault(x.name(), label)
+    out: dict[str, str] = {label: label for label in LABEL_ROOTS}
+    category_words = {f for f in forms if " " not in f}
+    # The roots' own lemmas are the class's synonyms ("mug", "rucksack", "microwave oven"), unless
+    # two classes share one ("bag": a handbag and a suitcase).
+    root_lemmas: dict[str, set[str]] = {}
+    for label, roots in LABEL_ROOTS.items():
+        for n in roots:
+            for lem in wn.synset(n).lemmas():
+                root_lemmas.setdefault(_form(lem.name()), set()).add(label)
+    for form, labels in sorted(root_lemmas.items()):
+        if len(labels) == 1 and form not in forms and form not in colour_words and form not in ROOM_WORDS \
+                and form == form.lower():
+            out.setdefault(form, next(iter(labels)))
+    for name in sorted(owner):
+        for lem in wn.synset(name).lemmas():
+            lemma, form = lem.name(), _form(lem.name())
+            if lemma != lemma.lower() or form in forms or form in colour_words or form in ROOM_WORDS or form in out:
+                continue
+            if len(form.split()) > 3 or not all(ch.isalpha() or ch in " -'" for ch in form):
+                continue
+            if " " not in form and any(wn.synsets(lemma, pos) for pos in ("v", "a", "s", "r")):
+                continue
+            if category_words.intersection(form.split()):
+                continue  # "toilet bowl": a part of a category's object, said with its name
+            senses = [x for x in wn.synsets(lemma, "n") if x.lexname() in CONCRETE
+                      and any(lm.name() == lemma for lm in x.lemmas())]
+            if senses and owner.get(senses[0].name()) == owner[name]:
+                out[form] = owner[name]
+    return dict(sorted(out.items()))
 
 
 #: The heads of WordNet's size clusters and the size word each stands for.

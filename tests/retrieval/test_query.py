@@ -37,7 +37,7 @@ def test_a_truncated_word_is_not_a_typo() -> None:
 
 
 @pytest.mark.parametrize(("text", "cat", "unknown"), [
-    ("the pool table", None, ["pool", "table"]), ("the grandfather clock", None, ["grandfather", "clock"]),
+    ("the pool table", None, ["pool", "table"]), ("the grandfather clock", "clock", []),  # a COCO class
     ("the second chair", "chair", []), ("the wooden table", "table", []), ("the yelow sofa", "sofa", []),
 ])
 def test_compound_names_are_other_objects(text, cat, unknown):
@@ -149,7 +149,7 @@ def test_negations(text, cat, neg):
 
 
 @pytest.mark.parametrize(("text", "cat", "neg"), [
-    ("the vase that is not red or blue", None, ["red", "blue"]),
+    ("the vase that is not red or blue", "vase", ["red", "blue"]),
     ("not the white or the grey stool", "stool", ["white", "grey"]),
     ("a lamp which isn't in the kitchen or in the office", "lamp", ["in the kitchen", "in the office"]),
 ])

@@ -41,6 +41,9 @@ class Lexicon:
     #: a word naming a plant's growth form ("cactus", "prickly") -> the growth word the captioner
     #: measures from the points ("slender"; ``capnav.language.form.growth``)
     growth: dict[str, str] = field(default_factory=dict)
+    #: a surface form -> the detector class it names, for the detector's classes that are not
+    #: categories ("mug" -> "cup", "mobile phone" -> "cell phone"; WordNet's, see build_lexicon)
+    labels: dict[str, str] = field(default_factory=dict)
     load_seconds: float = 0.0
 
     def category_alternatives(self, category: str, form: str | None = None) -> dict[str, float]:
@@ -74,7 +77,7 @@ def load_lexicon() -> Lexicon:
                   glosses={k: tuple(v) for k, v in raw.get("glosses", {}).items()},
                   foreign=frozenset(raw.get("foreign", [])), english=frozenset(raw.get("english", [])),
                   not_typos=frozenset(raw.get("not_typos", [])), sizes=dict(raw.get("sizes", {})),
-                  growth=dict(raw.get("growth", {})))
+                  growth=dict(raw.get("growth", {})), labels=dict(raw.get("labels", {})))
     object.__setattr__(lex, "load_seconds", time.perf_counter() - t0)
     return lex
 

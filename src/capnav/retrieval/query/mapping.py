@@ -11,6 +11,7 @@ from __future__ import annotations
 import re
 from typing import TYPE_CHECKING
 
+from capnav.core.categories import BY_NAME
 from capnav.language.colors import ALIASES, LEXICON
 from capnav.language.context import ROOM_SYNONYMS
 from capnav.language.purpose import find_activity, match_purpose, purpose_categories
@@ -286,9 +287,13 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
         q.shapes = list(dict.fromkeys([*q.shapes, "L-shaped"]))
     q.materials = [w for w in words if w in _MATERIALS]
     cat, span, fuzzy = _find_category(words)
-    other = _other_object(words, span)
+    other = _other_object(words, span) if cat in BY_NAME else None  # a class's own compound names it
     if other is not None:
         # "pool table", "power plant": WordNet names another object ending in a category word.
+        cat, span = None, None
+    if cat is not None and cat not in BY_NAME and find_activity(head) is not None:
+        # "somewhere to leave my phone", "where can I put my books": the thing is what the
+        # activity is about; the target is the furniture that serves it.
         cat, span = None, None
     q.category = cat
     if cat == "plant":

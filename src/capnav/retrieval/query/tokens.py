@@ -54,6 +54,13 @@ for _cat in CATEGORIES:
     for _f in (_cat.name, *_cat.synonyms):
         _FORM_MAP[_f] = _cat.name
         _FORM_MAP.setdefault(_plural(_f), _cat.name)
+#: The detector's classes that are not categories, by their everyday names (WordNet's, the
+#: lexicon's ``labels``): "the mug on the table" asks for a cup, not the table.
+LABEL_MAP: dict[str, str] = {}
+for _f, _c in sorted(_LEX.labels.items()):
+    if _f not in _FORM_MAP:
+        LABEL_MAP[_f] = _c
+        LABEL_MAP.setdefault(_plural(_f), _c)
 _FORM_WORDS = {w for f in _FORM_MAP for w in f.split()}
 _FORM_LENGTHS = sorted({len(f) for f in _FORM_MAP})
 
@@ -101,7 +108,7 @@ _GROWTH_TOKENS = {w for f in _GROWTH for w in f.split()}
 _RELATIONS = [END_OF, "in front of", "facing", "next to", "close to", "beside", "besides", "near", "by", "behind",
               "opposite", "across from", "alongside", "against"]
 _MATERIALS = {"wooden", "wood", "leather", "fabric", "velvet", "metal", "glass", "marble", "plastic",
-              "ceramic", "stainless", "steel", "laminate", "cotton", "acrylic", "paper", "terracotta"}
+              "ceramic", "stainless", "steel", "laminate", "cotton", "acrylic", "paper", "terracotta", "chrome"}
 _FILLER = {"go", "to", "the", "a", "an", "please", "find", "navigate", "take", "me", "walk", "head", "move",
            "drive", "could", "you", "can", "would", "kindly", "toward", "towards", "over", "there", "that",
            "one", "of", "is", "which", "i", "want", "need", "get", "bring", "robot", "hey", "and", "with",
@@ -157,6 +164,25 @@ def validate_instruction(text: object) -> str:
 
 
 def _find_category(words: list[str]) -> tuple[str | None, tuple[int, int] | None, bool]:
+    """(category, word span, fuzzy) of the first object mention: a category (exact n-grams before
+    typos), or a detector class named before it ("the mug on the table": a cup)."""
+    cat, span, fuzzy = _find_vocabulary(words)
+    # A class's exact name also beats a typo read at the same place ("hair drier" is no "chair").
+    label = _find_label(words, len(words) if span is None else span[0] + int(fuzzy))
+    return label if label is not None else (cat, span, fuzzy)
+
+
+def _find_label(words: list[str], before: int) -> tuple[str, tuple[int, int], bool] | None:
+    """The first detector-class name starting before word ``before`` (longest first), else None."""
+    for i in range(min(before, len(words))):
+        for n in (3, 2, 1):
+            gram = " ".join(words[i:i + n])
+            if i + n <= len(words) and gram in LABEL_MAP:
+                return LABEL_MAP[gram], (i, i + n), False
+    return None
+
+
+def _find_vocabulary(words: list[str]) -> tuple[str | None, tuple[int, int] | None, bool]:
     """(category, word span, fuzzy) of the first category mention; exact n-grams before typos."""
     for n in (3, 2):
         for i in range(len(words) - n + 1):
@@ -179,7 +205,7 @@ def _find_category(words: list[str]) -> tuple[str | None, tuple[int, int] | None
             return _FORM_MAP[words[i]], (i, i + 1), False
     for i, w in enumerate(words):
         if len(w) < 4 or w in _FILLER or canonical_color(w) or w in _SHAPES or w in _SIZE_WORDS \
-                or w in _LEX.not_typos:
+                or w in _LEX.not_typos or w in LABEL_MAP:
             continue
         near = difflib.get_close_matches(w, _SINGLE_FORMS, n=1, cutoff=0.8)
         # A word two or more letters short of a name's start is another word, not a typo ("wash").
@@ -195,8 +221,10 @@ _COLOR_NOT_ALONE = {"light", "dark", "pale", "deep", "bright", "soft", "rich", "
 def _color_name(phrase: str) -> str | None:
     """The palette name of a colour phrase when it has one ("gray" -> "grey"), else the phrase
     itself when it names a colour ("reddish", "pale pink", "dark wooden"), else None."""
-    if phrase in _COLOR_NOT_ALONE or phrase in _FORM_MAP:
+    if phrase in _COLOR_NOT_ALONE or phrase in _FORM_MAP or phrase in LABEL_MAP:
         return None
+    if phrase in _MATERIALS and phrase != "terracotta":
+        return None  # "stainless steel", "chrome": what it is made of, not a colour (the material says it)
     name = canonical_color(phrase)
     if name is not None:
         return name
