@@ -7,6 +7,7 @@ activity as its use."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from capnav.language import create_embedder
@@ -101,3 +102,22 @@ def test_an_activity_with_any_subject_or_a_wish(text, activity):
 
 def test_where_something_can_be_found_is_no_activity():
     assert find_activity("where can the remote be found") is None
+
+
+def test_glosses_stored_before_stated_purposes_stay_valid(emb):
+    # A map captioned before stated purposes were embedded holds only the gloss block: its
+    # vectors are reused and only the stated purposes are computed.
+    idx = GlossIndex(emb)
+    old = {k: v for k, v in idx.to_store().items() if k != "stated"}
+    calls = []
+
+    class Counting:
+        model_id, dim = emb.model_id, emb.dim
+
+        def embed(self, texts):
+            calls.append(len(texts))
+            return emb.embed(texts)
+
+    again = GlossIndex(Counting(), stored=old)  # type: ignore[arg-type]
+    assert calls == [len(idx.stated_cats)]
+    assert np.allclose(again.E, idx.E, atol=1e-6)

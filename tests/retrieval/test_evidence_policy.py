@@ -153,3 +153,17 @@ def test_a_negated_material_with_no_confirmed_instance_keeps_the_ones_shown_agai
     r.judge._surfaces[2] = Surface("smooth", 0.8, 0.4, 3000, "plain", 1.5, 0.7)  # velvet-like pile
     res = r.query("the sofa which isn't leather")
     assert res.found and res.chosen.id == 2, res.reason
+
+
+def test_an_absent_description_is_not_answered_by_the_named_category_contradicting_it(emb):
+    from capnav.language.surface import Surface
+
+    # The only sofa shows a weave; the armchair shows leather's grain. "The leather sofa" is
+    # neither: the sofa contradicts the material, the armchair is no kind of sofa.
+    r = _retriever(emb, [make_obj(1, "sofa", (1.5, 1.0), (2.0, 0.9, 0.8), (90, 60, 40)),
+                         make_obj(2, "armchair", (5.0, 1.0), (0.8, 0.8, 0.9), (90, 60, 40))])
+    r.judge._surfaces[1] = Surface("woven", 1.6, 0.6, 3000, "woven", 6.0, 4.0)
+    r.judge._surfaces[2] = Surface("smooth", 1.0, 0.5, 3000, "grainy", 9.0, 4.0)
+    res = r.query("take me to the leather sofa")
+    assert not res.found, res.reason
+    assert "'leather' while its pixels show a woven surface" in res.reason

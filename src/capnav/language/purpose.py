@@ -170,20 +170,33 @@ class GlossIndex:
         self.n_glosses = len(texts)
         #: Per stated purpose (rows after the glosses): its category.
         self.stated_cats = [c for c, _ in stated]
-        texts += [PurposeConfig().template.format(activity=clause) for _, clause in stated]
+        said = [PurposeConfig().template.format(activity=clause) for _, clause in stated]
         self.cats_arr = np.array(self.cats, dtype=object)
-        h = hashlib.sha256(f"{embedder.model_id}\n{embedder.dim}\n".encode())
-        h.update("\n".join(texts).encode())
-        self.digest = h.hexdigest()
+        # Two blocks, each with its digest: maps captioned before stated purposes were embedded
+        # keep their gloss vectors valid and compute only the stated ones.
+        self.digest = _digest(embedder, texts)
+        self.stated_digest = _digest(embedder, said)
         E = _decode(stored, self.digest, (len(texts), embedder.dim)) if stored else None
+        block = stored.get("stated") if stored else None
+        S = _decode(block, self.stated_digest, (len(said), embedder.dim)) if isinstance(block, dict) else None
+        todo = ([] if E is not None else texts) + ([] if S is not None else said)
+        new = embedder.embed(todo) if todo else np.zeros((0, embedder.dim), np.float32)
         if E is None:
-            E = embedder.embed(texts) if texts else np.zeros((0, embedder.dim), np.float32)
-        self.E: NDArray[np.float32] = E
+            E, new = new[: len(texts)], new[len(texts):]
+        if S is None:
+            S = new[: len(said)]
+        self.E: NDArray[np.float32] = np.vstack([E, S]).astype(np.float32) if len(S) else E
 
     def to_store(self) -> dict[str, Any]:
-        """JSON-able: model, digest, shape and the float32 vectors (little-endian, base64)."""
-        return {"model": self.embedder.model_id, "digest": self.digest, "shape": list(self.E.shape),
-                "float32_le": base64.b64encode(np.ascontiguousarray(self.E, dtype="<f4").tobytes()).decode("ascii")}
+        """JSON-able: model, digest, shape and the float32 vectors (little-endian, base64) of the
+        glosses, and the same under ``stated`` for the stated purposes."""
+        def block(E: NDArray[np.float32], digest: str) -> dict[str, Any]:
+            return {"model": self.embedder.model_id, "digest": digest, "shape": list(E.shape),
+                    "float32_le": base64.b64encode(np.ascontiguousarray(E, dtype="<f4").tobytes()).decode("ascii")}
+
+        out = block(self.E[: self.n_glosses], self.digest)
+        out["stated"] = block(self.E[self.n_glosses:], self.stated_digest)
+        return out
 
     def scores(self, activity: str, config: PurposeConfig | None = None,
                along: Sequence[str] = ()) -> dict[str, float]:
@@ -213,6 +226,12 @@ class GlossIndex:
         w = cfg.stated_weight
         out = {c: (1.0 - w) * v + w * made.get(c, v) for c, v in out.items()}
         return dict(sorted(out.items(), key=lambda kv: -kv[1]))
+
+
+def _digest(embedder: TextEmbedder, texts: list[str]) -> str:
+    h = hashlib.sha256(f"{embedder.model_id}\n{embedder.dim}\n".encode())
+    h.update("\n".join(texts).encode())
+    return h.hexdigest()
 
 
 def _decode(stored: dict[str, Any], digest: str, shape: tuple[int, int]) -> NDArray[np.float32] | None:
