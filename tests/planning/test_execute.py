@@ -143,3 +143,38 @@ def test_unreachable_object_stops_at_the_closest_cell_with_the_reason(sim) -> No
     assert not res.reached and res.goal is not None and not res.goal.reached_within_reach
     assert "no reachable free cell within 1.00 m" in res.reason
     assert 1.0 < res.distance_to_object < 2.0  # it went as close as the map allows
+
+
+class Retracer:
+    """A thin agent that drives anywhere (the map's walls are thicker than the world's) and keeps its trajectory."""
+
+    def __init__(self, path: list[tuple[float, float]]) -> None:
+        self.trajectory = list(path)
+
+    @property
+    def pose(self) -> tuple[float, float, float]:
+        return (*self.trajectory[-1], 0.0)
+
+    def move_to(self, x: float, y: float) -> bool:
+        self.trajectory.append((x, y))
+        return True
+
+
+def test_boxed_in_it_backs_out_the_way_it_came_and_says_so() -> None:
+    from capnav.core.grid import OCCUPIED, GridSpec
+
+    # A room east of x = 1.6 m and a dead-end corridor 0.3 m wide west of it, narrower on the map
+    # than any relaxation lets the 0.2 m robot plan in: from its end there is no plan at all.
+    spec = GridSpec(0.0, 0.0, 0.05, 60, 120)
+    cells = np.full((60, 120), OCCUPIED, np.uint8)
+    cells[3:57, 32:117] = FREE  # the room, x 1.6-5.85 m
+    cells[27:33, 18:32] = FREE  # the corridor, x 0.9-1.6 m, y 1.35-1.65 m
+    occ = OccupancyGrid(spec, cells)
+    fp = np.array([[4.4, 1.4], [4.6, 1.4], [4.6, 1.6], [4.4, 1.6]])
+    agent = Retracer([(3.0, 1.5), (2.0, 1.5), (1.0, 1.5)])
+    res = navigate_to(agent, occ, fp)
+    assert res.reached and res.recovery and res.recovery[0].startswith("backed out 0.50 m along the way it came")
+    assert "recovery" in res.to_dict() and any("backed out" in e for e in res.events)
+    # without a way it came, the same spot is the user's error with its reason
+    with pytest.raises(InputError, match="no free cell within"):
+        navigate_to(Retracer([(1.0, 1.5)]), occ, fp)

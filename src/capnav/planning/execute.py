@@ -51,6 +51,7 @@ class NavResult:
     trajectory: NDArray[np.float64] = field(default_factory=lambda: np.empty((0, 2)))  # (T, 2) executed x, y
     plans: list[PlannedPath] = field(default_factory=list)
     events: list[str] = field(default_factory=list)
+    recovery: list[str] = field(default_factory=list)  # escapes used: backing out, relaxed inflation
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -65,6 +66,7 @@ class NavResult:
             "trajectory": np.round(self.trajectory, 4).tolist(),
             "plans": [p.to_dict() for p in self.plans],
             "events": list(self.events),
+            "recovery": list(self.recovery),
         }
 
 
@@ -89,19 +91,35 @@ def navigate_to(agent: StepAgent, occ: OccupancyGrid, target_footprint: NDArray[
         costmap = None
     levels = _Levels(occ, cfg, costmap, columns, z_range)
     log = _Log(agent, cfg.max_steps)
+    recovery: list[str] = []  # which escapes were used, in order
     goal: GoalPose | None = None
     plans: list[PlannedPath] = []
     replans = 0
     reason = ""
     first = True
+    backed = False
     while True:
         try:
             goal, plan, note = levels.plan(fp, log.xy())
         except CapNavError as e:
+            # Boxed in (a pocket, or marks from contacts): back out the way it came, once, and try again.
+            if not backed and (moved := _back_out(agent, cfg, log)) > 0:
+                backed = True
+                recovery.append(f"backed out {moved:.2f} m along the way it came (no plan from where it stood: {e})")
+                events.append(recovery[-1])
+                continue
             if first:
                 raise
             reason = f"replanning failed after {replans} collision(s): {e}"
             break
+        if not goal.reached_within_reach and not backed and (moved := _back_out(agent, cfg, log)) > 0:
+            backed = True
+            recovery.append(f"backed out {moved:.2f} m along the way it came (nothing within reach from where it "
+                            "stood)")
+            events.append(recovery[-1])
+            continue
+        if note:
+            recovery.append(note)
         first = False
         plans.append(plan)
         events.extend([*plan.notes, *([note] if note else [])])
@@ -129,7 +147,7 @@ def navigate_to(agent: StepAgent, occ: OccupancyGrid, target_footprint: NDArray[
         reason = f"stopped {dist:.2f} m from the object (reach {cfg.reach:.2f} m): {reason}"
     return NavResult(reached, (pose[0], pose[1], pose[2]), log.length, replans,
                      plans[-1].waypoints if plans else np.empty((0, 2)), reason, goal, dist, log.array(), plans,
-                     events)
+                     events, recovery)
 
 
 class _Levels:
@@ -144,6 +162,7 @@ class _Levels:
     def __init__(self, occ: OccupancyGrid, cfg: PlannerConfig, costmap: Costmap | None,
                  columns: HeightColumns | None = None, z_range: tuple[float, float] | None = None) -> None:
         self.z_range = z_range
+        self.radius = cfg.robot_radius
         self.cfgs = [cfg]
         if cfg.relax:
             half = 0.5 * occ.spec.resolution
@@ -176,8 +195,10 @@ class _Levels:
             except CapNavError as e:
                 error = error or e
                 continue
-            note = "" if i == 0 else (f"relaxed inflation to {cfg.inflation:.3f} m: nothing within reach at "
-                                      f"{self.cfgs[0].inflation:.3f} m")
+            what = ("the robot's true radius" if abs(cfg.inflation - self.radius) < 1e-9 else
+                    "half a cell under the true radius: a cell whose centre is clear may fit")
+            note = "" if i == 0 else (f"relaxed inflation to {cfg.inflation:.3f} m ({what}): nothing within reach "
+                                      f"at {self.cfgs[0].inflation:.3f} m")
             if goal.reached_within_reach:
                 return goal, plan, note
             fallback = fallback or (goal, plan, note)
@@ -240,6 +261,37 @@ def _follow(agent: StepAgent, waypoints: NDArray[np.float64], cfg: PlannerConfig
         if not ok:
             return _contact_point(agent, wp, cfg, log)
     return None
+
+
+#: How far the executor backs out along the way it came when boxed in (m).
+BACK_OUT_M = 0.5
+
+
+def _back_out(agent: StepAgent, cfg: PlannerConfig, log: _Log, distance: float = BACK_OUT_M) -> float:
+    """Drive back along the agent's own trajectory (the way it came, known to be passable) for up
+    to ``distance`` metres; returns how far it got (0 with no trajectory to retrace)."""
+    traj = _trajectory(agent)
+    if len(traj) < 2:
+        return 0.0
+    here = np.asarray(traj[-1], dtype=np.float64)
+    back, total = [], 0.0
+    prev = here
+    for p in reversed(traj[:-1]):
+        q = np.asarray(p, dtype=np.float64)
+        step = float(np.linalg.norm(q - prev))
+        if step < 1e-9:
+            continue
+        if total + step >= distance:  # stop part-way along this segment
+            back.append(prev + (q - prev) * ((distance - total) / step))
+            break
+        total += step
+        back.append(q)
+        prev = q
+    if not back:
+        return 0.0
+    start = np.asarray(log.xy(), dtype=np.float64)
+    _follow(agent, np.vstack([start, *back]), cfg, log)
+    return float(np.linalg.norm(np.asarray(log.xy()) - start))
 
 
 def _trajectory(agent: object) -> list[tuple[float, float]]:
