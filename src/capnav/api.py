@@ -354,8 +354,10 @@ class CapNav:
         xy = _xy(robot, "robot")
         if k is not None and not 0 <= int(k) <= 50:
             raise InputError(f"k must be between 0 and 50, got {k}")
+        from capnav.retrieval.query import prefetch_parser, validate_instruction
         from capnav.retrieval.sequence import query_goals
 
+        prefetch_parser(validate_instruction(instruction))  # while the embedder's session is built
         seq = query_goals(self.retriever, instruction, robot_xy=xy)
         answers: list[Answer] = []
         for res in seq.results:

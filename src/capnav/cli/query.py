@@ -55,6 +55,9 @@ def register(app: typer.Typer) -> None:
         # retrieval code imports and the map loads: a one-shot query's wall time on two cores.
         with ThreadPoolExecutor(1) as pool:
             pending = pool.submit(create_embedder, "minilm" if embedder == "auto" else embedder, **kw)
+            from capnav.retrieval.query import prefetch_parser, validate_instruction
+
+            prefetch_parser(validate_instruction(instruction))  # a sentence's parser loads meanwhile
             from capnav.io.mapfile import load_map
             from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
             from capnav.retrieval.sequence import query_goals

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 from capnav.core.errors import InputError
 from capnav.retrieval.query.mapping import goal_query
 from capnav.retrieval.query.model import BETWEEN, END_OF, ROOM_WITH, ParsedQuery
-from capnav.retrieval.query.parse import analyse, load_parser, needs_parse, split_goals
+from capnav.retrieval.query.parse import analyse, load_parser, needs_parse, prefetch_parser, split_goals
 from capnav.retrieval.query.tokens import MAX_CHARS, MAX_WORDS, validate_instruction
 
 if TYPE_CHECKING:
@@ -47,5 +47,19 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None, use_parse
     return q
 
 
-__all__ = ["BETWEEN", "END_OF", "MAX_CHARS", "MAX_GOALS", "MAX_WORDS", "ROOM_WITH", "ParsedQuery", "load_parser",
-           "needs_parse", "parse_goals", "parse_instruction", "split_goals", "validate_instruction"]
+__all__ = [
+    "BETWEEN",
+    "END_OF",
+    "MAX_CHARS",
+    "MAX_GOALS",
+    "MAX_WORDS",
+    "ROOM_WITH",
+    "ParsedQuery",
+    "load_parser",
+    "needs_parse",
+    "parse_goals",
+    "parse_instruction",
+    "prefetch_parser",
+    "split_goals",
+    "validate_instruction",
+]

@@ -116,6 +116,17 @@ def load_parser() -> Language | None:
         return nlp
 
 
+def prefetch_parser(text: str) -> threading.Thread | None:
+    """Start loading the parser in a thread when ``text`` will need it, so that its import
+    overlaps the embedder's session build and the map load (which release the interpreter lock);
+    the parse waits for it through the load lock. None when nothing is to load."""
+    if _NLP or not needs_parse(text):
+        return None
+    t = threading.Thread(target=load_parser, name="capnav-parser-load", daemon=True)
+    t.start()
+    return t
+
+
 def parser_name() -> str:
     nlp = load_parser()
     if nlp is None:
