@@ -36,11 +36,16 @@ def agree(n: int, word: str) -> str:
     return plural(word) if word in _PLURALS or not word.endswith("s") else word[:-1]
 
 
-def count(n: int, noun: str, number_words: bool = True) -> str:
-    """"1 chair", "3 chairs", "no chairs" (with ``number_words``, one to nine in words)."""
+def count(n: int, noun: str, number_words: bool = False) -> str:
+    """"1 chair", "3 chairs", "0 chairs" (with ``number_words``: "one chair", "no chairs")."""
     words = ("no", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine")
     shown = words[n] if number_words and 0 <= n < len(words) else str(n)
     return f"{shown} {noun if n == 1 else plural(noun)}"
+
+
+def of_them(n: int, verb: str) -> str:
+    """"none of them stands", "1 of them stands", "3 of them stand" (``verb`` in the singular)."""
+    return f"none of them {verb}" if n == 0 else f"{n} of them {agree(n, verb)}"
 
 
 def join(items: Iterable[str], last: str = "and") -> str:

@@ -170,7 +170,8 @@ def _answer(k: int, text: str, kind: str, targets: list[int], retriever: Retriev
     q, nav, obj = res.query, res.nav, res.query.chosen
     item = ReportItem(text, kind, q.found, obj.id if obj else None, obj.label if obj else None,
                       obj.caption if obj else None, q.score if q.found else None, q.reason,
-                      runners_up=[f"{o.id} {o.label} ({s:.2f})" for o, s in q.ranked[:3]], timings=dict(q.timings))
+                      runners_up=[f"{o.id} {o.label}" for o, _ in q.ranked[:3]], timings=dict(q.timings),
+                      candidates=_candidates(q))
     if kind == "absent":
         item.correct = not q.found
     elif targets:  # right only when the agent stops within reach of an instance the instruction meant
@@ -190,3 +191,17 @@ def _answer(k: int, text: str, kind: str, targets: list[int], retriever: Retriev
     if res.png is not None:
         item.map_png = f"images/{res.png.name}"
     return item
+
+
+def _candidates(q: Any, n: int = 4) -> list[dict[str, Any]]:
+    """The chosen object and up to ``n`` runners-up with each score on its own scale."""
+    out: list[dict[str, Any]] = []
+    if q.chosen is not None:
+        ver = q.verification
+        out.append({"id": q.chosen.id, "label": q.chosen.label, "similarity": q.score, "verifier": ver,
+                    "final": ver if ver is not None else q.score, "why": "chosen", "chosen": True})
+    for k, (o, final) in enumerate(q.ranked[:n]):
+        d = q.details[k] if k < len(q.details) else {}
+        out.append({"id": o.id, "label": o.label, "similarity": d.get("similarity"), "verifier": d.get("verifier"),
+                    "final": final, "why": d.get("why", ""), "chosen": False})
+    return out

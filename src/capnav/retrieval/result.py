@@ -21,9 +21,11 @@ class QueryResult:
     mode: str = "semantic"
     distance_m: float | None = None  # robot to goal in the grid (eq. 17) when a robot position is known
     query: dict[str, Any] = field(default_factory=dict)
-    #: Per runner-up: its terms (similarity, colour agreement, distance, ...) and why it lost.
+    #: Per runner-up: its terms (similarity, colour agreement, distance, ...), why it lost, its caption
+    #: similarity and its verifier score (None when the verifier did not judge it).
     details: list[dict[str, Any]] = field(default_factory=list)
     terms: dict[str, float] = field(default_factory=dict)  # the chosen object's terms
+    verification: float | None = None  # the verifier's score of the chosen object (None: not judged)
 
     def runners_up(self) -> list[dict[str, Any]]:
         out = []

@@ -205,8 +205,11 @@ class Retriever:
         return QueryResult(q.text, self.objects[chosen_i] if chosen_i is not None else None, chosen_i is not None,
                            float(s[chosen_i]) if chosen_i is not None else 0.0,
                            [(self.objects[i], sc) for i, sc, _, _ in runners], predicate, reason, timings,
-                           mode, dist, q.to_dict(), [{"terms": t, "why": w} for _, _, t, w in runners],
-                           judged[chosen_i].terms if chosen_i in judged else {})
+                           mode, dist, q.to_dict(),
+                           [{"terms": t, "why": w, "similarity": float(s[i]),
+                             "verifier": judged[i].value if i in judged else None} for i, _, t, w in runners],
+                           judged[chosen_i].terms if chosen_i in judged else {},
+                           judged[chosen_i].value if chosen_i in judged else None)
 
     def _about_time(self, instruction: str, robot_xy: tuple[float, float] | None) -> QueryResult | None:
         """Time words narrow the objects; a best match that is retired is "not found" (when last seen).
@@ -294,7 +297,7 @@ class Retriever:
             if a_ is not None and not a_.ok:
                 why = f"rejected: {a_.reason}"
             elif a_ is None:
-                why = "not verified (a candidate before it was accepted)" if chosen is not None else "not verified"
+                why = "not verified (one before it was accepted)" if chosen is not None else "not verified"
             else:
                 why = self._difference(a_, best, rk, i, chosen)
             score = a_.value if a_ is not None else float(s[i])
@@ -306,30 +309,40 @@ class Retriever:
     def _difference(self, a_: Assessment, best: Assessment | None, rk: Ranking, i: int, chosen: int | None) -> str:
         """The terms in which the chosen candidate beat this one."""
         if best is None or chosen is None:
-            return f"acceptable (score {a_.value:.2f})"
+            return f"acceptable (verification score {a_.value:.2f})"
         group = {int(k): int(g) for k, g in zip(rk.order, rk.groups, strict=True)}
         if group.get(i, 0) > group.get(chosen, 0):
             pred = rk.terms.get(i, {})
             mine = rk.terms.get(chosen, {})
             diffs = [f"{k} {pred[k]:.2f} vs {mine[k]:.2f}" for k in pred if k in mine and abs(pred[k] - mine[k]) > 1e-6]
-            return f"ranked after it by {rk.predicate or 'category'}" + (f" ({'; '.join(diffs)})" if diffs else "")
+            by = f"by '{rk.predicate}'" if rk.predicate else "as a stand-in category"
+            return f"ranked after the chosen object {by}" + (f" ({'; '.join(diffs)})" if diffs else "")
         diffs = [f"{k} {a_.terms[k]:.2f} vs {best.terms[k]:.2f}" for k in a_.terms
                  if k in best.terms and k != "similarity" and a_.terms[k] < best.terms[k] - 1e-6]
-        return f"lower score {a_.value:.2f} vs {best.value:.2f}" + (f" ({'; '.join(diffs)})" if diffs else "")
+        return (f"lower verification score {a_.value:.2f} vs {best.value:.2f}"
+                + (f" ({'; '.join(diffs)})" if diffs else ""))
 
     def _explain(self, q: ParsedQuery, i: int | None, s: NDArray[np.float32], rk: Ranking, notes: list[str],
                  verdict: str, dist: float | None, verifier: Verifier,
                  runners: list[tuple[int, float, dict[str, float], str]], judged: dict[int, Assessment],
                  dist_kind: str = "straight") -> str:
         target = q.target_phrase or q.text
+        extra = f" Notes: {'; '.join(n.rstrip('.') for n in notes)}." if notes else ""
         if i is None:
-            base = f"Not found: nothing in the map is {a(target)}"
-            text = f"{base} ({verdict})."
-            if runners:
-                text += " Closest candidates: " + "; ".join(
-                    f"object {self.objects[k].id} ({self.cats[k]}, score {sc:.2f}) {why}"
-                    for k, sc, _, why in runners[:3]) + "."
-            return text + (f" {'; '.join(notes)}." if notes else "")
+            # The verifier's clause speaks of one candidate ("it is a plant, not a cabinet"): name it.
+            who = next((k for k, a_ in judged.items() if not a_.ok and a_.reason == verdict), None)
+            if who is not None:
+                why = (f"the best candidate, object {self.objects[who].id} ({self.cats[who]}), was rejected by the "
+                       f"{verifier.name} verifier: {verdict}")
+            else:
+                why = verdict
+            text = f"Not found: nothing in the map is {a(target)}" + (f"; {why}." if why else ".")
+            rest = [(k, w) for k, _, _, w in runners if k != who][:3]
+            if rest:
+                text += " Other candidates: " + "; ".join(
+                    f"object {self.objects[k].id} ({self.cats[k]}) {w.replace('rejected: ', 'was rejected: ', 1)}"
+                    for k, w in rest) + "."
+            return text + extra
         o = self.objects[i]
         mode, predicate = rk.mode, rk.predicate
         if mode == "closest":
@@ -337,14 +350,13 @@ class Retriever:
                   + ("" if dist is None else f" ({dist:.1f} m walking along the floor)"
                      if dist_kind == "walking" else f" ({dist:.1f} m in a straight line on the grid)")
         elif mode == "predicate":
-            how = f"it best satisfies '{predicate}'"
+            how = f"it best satisfies '{f'in the {q.room}' if predicate == 'room' and q.room else predicate}'"
         elif i in judged and judged[i].ok:
             how = f"it has the highest verification score ({judged[i].value:.2f})"
         else:
             how = "it is the first candidate in the similarity ranking"
-        text = f"Chose object {o.id} ({o.caption}) because {how}; caption similarity {s[i]:.2f}"
+        caption = (o.caption or o.label).rstrip(".")
+        text = f"Chose object {o.id} ({caption}) because {how}; caption similarity {s[i]:.2f}."
         if verdict:
-            text += f"; verifier ({verifier.name}): {verdict}"
-        if notes:
-            text += f". Notes: {'; '.join(notes)}"
-        return text + "."
+            text += f" The {verifier.name} verifier accepted it: {verdict}."
+        return text + extra

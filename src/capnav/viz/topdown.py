@@ -33,6 +33,58 @@ def short_label(obj: MapObject, width: int = 12) -> str:
     return f"{obj.id} {name}"
 
 
+#: Objects at least this tall (m) are hatched and labelled with their height: seen from the side
+#: only (a wardrobe, a fridge), their tops are never observed, and a picture from above would
+#: otherwise not tell them from a low box.
+TALL_M = 1.5
+#: A footprint hull filling less than this share of its smallest enclosing rectangle is drawn as the
+#: rectangle: a box seen from one corner shows two faces, whose hull is a triangle.
+BOX_FILL = 0.7
+
+
+def object_height(obj: MapObject) -> float:
+    """Metres from the lowest to the highest observed point."""
+    return float(obj.extent_max[2] - obj.extent_min[2])
+
+
+def min_area_rectangle(pts: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The 4 corners of the smallest rectangle enclosing the convex polygon ``pts`` (rotating calipers:
+    one side of it lies on an edge of the hull). Of rectangles within 5% of the smallest, the one
+    whose sides carry most of the hull's perimeter: a box seen from a corner has a triangular hull of
+    equal-area rectangles on its two seen faces and on the unseen diagonal, and the faces are what
+    was observed."""
+    edges = np.diff(np.vstack([pts, pts[:1]]), axis=0)
+    lengths = np.hypot(edges[:, 0], edges[:, 1])
+    dirs = np.mod(np.arctan2(edges[:, 1], edges[:, 0]), np.pi / 2)
+    cands = []
+    for a in np.unique(np.round(dirs, 6)):
+        rot = np.array([[np.cos(a), np.sin(a)], [-np.sin(a), np.cos(a)]])
+        q = pts @ rot.T
+        lo, hi = q.min(axis=0), q.max(axis=0)
+        gap = np.abs((dirs - a + np.pi / 4) % (np.pi / 2) - np.pi / 4)  # edge angle to the sides, mod 90 deg
+        on_sides = float(lengths[gap < np.radians(3.0)].sum())
+        corners = np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])
+        cands.append((float(np.prod(hi - lo)), on_sides, corners @ rot))
+    smallest = min(c[0] for c in cands)
+    return max((c for c in cands if c[0] <= 1.05 * smallest), key=lambda c: c[1])[2]
+
+
+def _polygon_area(p: NDArray[np.float64]) -> float:
+    x, y = p[:, 0], p[:, 1]
+    return 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+
+
+def drawn_footprint(obj: MapObject) -> NDArray[np.float64] | None:
+    """The polygon drawn for an object: its footprint hull, or the hull's smallest rectangle when the
+    hull is a box seen from a corner (``BOX_FILL``); None when there is no footprint."""
+    fp = np.asarray(obj.footprint, dtype=np.float64)
+    if fp.ndim != 2 or len(fp) < 3:
+        return None
+    rect = min_area_rectangle(fp)
+    area = _polygon_area(rect)
+    return rect if area > 0 and _polygon_area(fp) < BOX_FILL * area else fp
+
+
 def occupancy_rgb(occ: OccupancyGrid) -> NDArray[np.float64]:
     lut = np.zeros((256, 3))
     for value, rgb in OCC_RGB.items():
@@ -66,15 +118,17 @@ def draw_navigation(occ: OccupancyGrid, objects: Sequence[MapObject], chosen_id:
     ax = fig.add_subplot(1, 1, 1)
     ax.imshow(occupancy_rgb(occ), origin="lower", extent=extent, interpolation="nearest")
     for obj in objects:
-        fp = np.asarray(obj.footprint, dtype=np.float64)
-        if fp.ndim != 2 or len(fp) < 3:
+        fp = drawn_footprint(obj)
+        if fp is None:
             continue
         chosen = obj.id == chosen_id
+        tall = object_height(obj) >= TALL_M
         ax.add_patch(Polygon(fp, closed=True, fill=True, alpha=0.6 if chosen else 0.5,
-                             facecolor=CHOSEN if chosen else "#7cc47f",
+                             facecolor=CHOSEN if chosen else "#7cc47f", hatch="////" if tall else None,
                              edgecolor=CHOSEN if chosen else "#1b5e20", linewidth=2.2 if chosen else 0.8))
         cx, cy = fp.mean(axis=0)
-        ax.text(cx, cy, short_label(obj), fontsize=7.5 if chosen else 5.5, ha="center", va="center",
+        label = short_label(obj) + (f"\n{object_height(obj):.1f} m tall" if tall else "")
+        ax.text(cx, cy, label, fontsize=7.5 if chosen else 5.5, ha="center", va="center",
                 color=CHOSEN if chosen else "#1b3d1b", fontweight="bold" if chosen else "normal",
                 bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.7})
         if chosen and reach:

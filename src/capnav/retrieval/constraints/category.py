@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from capnav.core.text import agree, article, count, join, plural
 from capnav.language.context import canonical_label
 from capnav.language.lexicon import load_lexicon
 from capnav.retrieval.constraints.base import RankingConstraint, RankState, ranking
@@ -27,16 +28,15 @@ class Category(RankingConstraint):
         weights = self.weights(st) if cfg.use_type_filter else np.zeros(n)
         st.named = q.category is not None or bool(q.category_alternatives)
         pool = np.flatnonzero(weights > 0)
+        at: int | None = None  # where the count note goes
         if st.named and cfg.use_type_filter and len(pool):
-            tier1 = int((weights[pool] >= 1.0).sum())
-            what = q.category or q.purpose or "target"
-            st.notes.append(f"{tier1} {what}(s) in the map" + (
-                f", {len(pool) - tier1} alternative(s) ({', '.join(sorted(q.category_alternatives))})"
-                if len(pool) > tier1 else ""))
+            st.notes.append("")  # filled in by _count_note once the stand-ins are known
+            at = len(st.notes) - 1
         else:
             if st.named and cfg.use_type_filter:
-                st.notes.append(f"no object in the map is captioned or labelled {q.category or 'as one of '}"
-                                + ("" if q.category else ", ".join(sorted(q.category_alternatives))))
+                st.notes.append("no object in the map is captioned or labelled as "
+                                + join([article(c) for c in ([q.category] if q.category else
+                                                             sorted(q.category_alternatives))], "or"))
             pool = np.arange(n)
             weights = np.ones(n)
         st.pool, st.weights = pool, weights
@@ -49,8 +49,10 @@ class Category(RankingConstraint):
             others = sorted({r.cats[int(i)] for i in st.pool[~keep]})
             st.keep(keep)
             if others:
-                st.notes.append(f"{', '.join(others)} {'is' if len(others) == 1 else 'are'} not a kind of "
+                st.notes.append(f"{join(plural(x) for x in others)} are not a kind of "
                                 f"{q.category} in the lexicon, so not considered")
+        if at is not None:
+            st.notes[at] = _count_note(st)
         if st.named and q.purpose is None and cfg.use_type_filter and len(pool) and not (weights[pool] >= 1.0).any():
             # No instance of the named category: a kind of it serves only a request whose observed
             # attributes or landmark it shows ("the round wooden table" -> a round coffee table),
@@ -93,3 +95,15 @@ def stand_ins(q: ParsedQuery) -> set[str]:
         for k in range(len(words) - n + 1):
             out |= set(lex.form_alternatives.get(" ".join(words[k:k + n]), {}))
     return {canonical_label(c) for c in out}
+
+
+def _count_note(st: RankState) -> str:
+    """"5 armchairs are in the map, and 3 chairs could stand in" for the candidates kept."""
+    q, r, w = st.q, st.r, st.weights
+    tier1 = int((w[st.pool] >= 1.0).sum())
+    head = count(tier1, q.category) if q.category else f"{count(tier1, 'object')} for {q.target_phrase!r}"
+    alts = sorted({r.cats[int(i)] for i in st.pool if w[i] < 1.0})
+    n_alt = len(st.pool) - tier1
+    stand_in = count(n_alt, alts[0]) if len(alts) == 1 else \
+        f"{count(n_alt, 'object')} ({join(plural(c) for c in alts)})"
+    return f"{head} {agree(tier1, 'is')} in the map" + (f", and {stand_in} could stand in" if alts else "")

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from capnav.core.text import of_them
 from capnav.language.context import HALLWAY, ROOM_CUES
 from capnav.retrieval.constraints.base import (
     CONTRADICTED,
@@ -56,7 +57,8 @@ class Room(RankingConstraint):
         st.order_keys.append(-strength)
         st.values["room cue"] = strength
         st.predicate, st.mode = "room", "predicate"
-        st.notes.append(f"{int(in_room.sum())} of them appear to be in the {room} (inferred from nearby objects)")
+        n = int(in_room.sum())
+        st.notes.append(f"{of_them(n, 'appears')} to be in the {room} (inferred from nearby objects)")
         # A room is inferred, never observed: refuse only where the evidence against the named
         # room is confident, i.e. no candidate of the best category tier has a cue of it in its
         # own room (a wardrobe beside the desk of a room typed "office" by that desk says
@@ -82,4 +84,5 @@ class Room(RankingConstraint):
         st.order_keys.append(-weakest)
         st.values["no room cue"] = weakest
         st.predicate, st.mode = "room", "predicate"
-        st.notes.append(f"{int(untyped.sum())} of them stand where no room's objects are (a hallway)")
+        n = int(untyped.sum())
+        st.notes.append(f"{of_them(n, 'stands')} where no room's objects are (a hallway)")
