@@ -1,7 +1,7 @@
 """The occupancy grid as a ROS ``map_server`` pair (PGM image + YAML), which Nav2, ROS 1's
 map_server and most robot stacks load as a static map.
 
-Rules (DESIGN.md, "Occupancy export (ROS map_server)"): pixels 254 free, 0 occupied, 205 unknown;
+Rules (docs/design.md, "Occupancy export (ROS map_server)"): pixels 254 free, 0 occupied, 205 unknown;
 the image's top row is the map's largest y; ``origin`` [x, y, 0] is the pose of the lower-left
 pixel's corner (CapNav's grid origin); ``negate: 0``, ``occupied_thresh: 0.65``, ``free_thresh:
 0.196``, ``mode: trinary``. map_server reads a pixel ``v`` as occupancy ``p = (255 - v) / 255``:

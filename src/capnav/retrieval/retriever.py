@@ -355,7 +355,7 @@ class Retriever:
             how = f"it has the highest verification score ({judged[i].value:.2f})"
         else:
             how = "it is the first candidate in the similarity ranking"
-        caption = (o.caption or o.label).rstrip(".")
+        caption = o.caption or o.label  # whole: callers find the caption in the reason
         text = f"Chose object {o.id} ({caption}) because {how}; caption similarity {s[i]:.2f}."
         if verdict:
             text += f" The {verifier.name} verifier accepted it: {verdict}."

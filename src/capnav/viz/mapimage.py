@@ -73,6 +73,21 @@ def _top_colours(cmap: CapNavMap, max_z: float) -> tuple[NDArray[np.bool_], NDAr
     return have, rgb
 
 
+#: Objects at least this tall (m) are hatched and labelled with their height (see viz.topdown).
+TALL_M = 1.5
+
+
+def _hatch(draw: ImageDraw.ImageDraw, box: tuple[float, float, float, float], rgb: tuple[int, int, int],
+           step: int = 7) -> None:
+    """Diagonal lines across ``box`` (u0, v0, u1, v1), clipped to it."""
+    u0, v0, u1, v1 = (round(x) for x in box)
+    w, h = u1 - u0, v1 - v0
+    for k in range(-h, w, step):
+        a = (u0 + max(k, 0), v0 + max(-k, 0))
+        b = (u0 + min(k + h, w), v0 + min(h, w - k))
+        draw.line((a, b), fill=rgb, width=1)
+
+
 def map_picture(cmap: CapNavMap, max_px: int = 900, max_z: float = 2.0, labels: bool = True) -> MapPicture:
     """Draw the map (occupancy, voxel colours from above, object boxes with their map ids)."""
     spec = cmap.occupancy.spec
@@ -89,9 +104,13 @@ def map_picture(cmap: CapNavMap, max_px: int = 900, max_z: float = 2.0, labels: 
     draw = ImageDraw.Draw(pic)
     for o in cmap.objects:
         (u0, v1), (u1, v0) = out.to_pixel(np.array([o.extent_min[:2], o.extent_max[:2]]))
+        height = float(o.extent_max[2] - o.extent_min[2])
+        if height >= TALL_M:  # its top was never seen from the camera's height: hatch it, say how tall
+            _hatch(draw, (u0, v0, u1, v1), (200, 40, 40))
         draw.rectangle((u0, v0, u1, v1), outline=(200, 40, 40), width=2)
         if labels:
-            draw.text((u0 + 3, v0 + 2), str(o.id), fill=(20, 20, 20))
+            draw.text((u0 + 3, v0 + 2), f"{o.id}" + (f" {height:.1f} m" if height >= TALL_M else ""),
+                      fill=(20, 20, 20))
     buf = io.BytesIO()
     pic.save(buf, format="PNG", optimize=True)
     return MapPicture(buf.getvalue(), pic.width, pic.height, scale, spec)
