@@ -149,15 +149,14 @@ def _parse_transform(text: str) -> Any:
 def _update(map_path: Path, reader: Any, output: Path, det: Any, enc: Any, cfg: Any, transform: str | None,
             icp: bool, progress: bool) -> None:
     """``capnav map --update MAP DATASET -o OUT``: register, fuse, write atomically under a lock."""
-    from rich.console import Console
-
     from capnav.cli.options import check_input_path
+    from capnav.core.console import make_console
     from capnav.io.mapfile import load_map, lock_map, save_map
     from capnav.mapping.update import check_same_home, register_recording, update_map
 
     check_input_path(map_path, "map file")
     init = _parse_transform(transform) if transform is not None else None
-    con = Console(stderr=True)
+    con = make_console(stderr=True)
     with lock_map(map_path), (lock_map(output) if output.resolve() != map_path.resolve() else _nothing()):
         cmap = load_map(map_path)
         check_same_home(cmap, reader, str(map_path))

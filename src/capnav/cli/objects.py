@@ -74,9 +74,9 @@ def register(app: typer.Typer) -> None:
                                                              "(moved, new, gone) and the retired objects"),
     ) -> None:
         """List the map's objects: id, label, votes, size, position, caption, views, last seen."""
-        from rich.console import Console
         from rich.table import Table
 
+        from capnav.core.console import make_console
         from capnav.io.mapfile import load_map
 
         check_input_path(map_path, "map file")
@@ -85,7 +85,7 @@ def register(app: typer.Typer) -> None:
         if as_json:
             typer.echo(json.dumps({"map": str(map_path), **rep}, indent=1))
             return
-        con = Console()
+        con = make_console()
         t = Table(title=f"{map_path}: {len(cmap.objects)} objects"
                         + (f", {len(cmap.retired)} retired" if cmap.retired else ""))
         for col in ("id", "label", "votes", "size (m)", "position (m)", "views", "last seen", "caption"):

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from capnav.core.text import of_them
+from capnav.core.text import agree, join, of_them, plural
 from capnav.language.context import HALLWAY, ROOM_CUES
 from capnav.retrieval.constraints.base import (
     CONTRADICTED,
@@ -66,9 +66,12 @@ class Room(RankingConstraint):
         top = st.weights[pool] >= st.weights[pool].max()
         possible = (strength >= r.scene.config.room_min_score) & top
         if not in_room.any() and not unknown.any() and not possible.any():
-            where = sorted({str(x) for x in rooms})
-            st.refuse(self.kind, f"no {q.category or q.target_phrase} stands in the {room}; "
-                                 f"{'they are' if len(pool) > 1 else 'it is'} in the {', the '.join(where)}")
+            where = join(f"the {x}" for x in sorted({str(x) for x in rooms}))
+            what = q.category or q.target_phrase
+            noun = what if all(r.cats[int(i)] == q.category for i in pool) else "candidate"
+            n = len(pool)
+            st.refuse(self.kind, f"no {what} stands in the {room}; "
+                                 f"the {plural(noun) if n > 1 else noun} {agree(n, 'is')} in {where}")
         elif not in_room.any() and possible.any():
             k = int(np.argmax(strength))
             st.notes.append(f"none is inferred to be in the {room}, but object {r.objects[pool[k]].id} "
