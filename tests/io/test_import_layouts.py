@@ -137,6 +137,12 @@ def test_auto_names_what_it_looked_for(tmp_path: Path) -> None:
     Image.fromarray(np.zeros((4, 4, 3), np.uint8)).save(tmp_path / "x" / "a.png")
     with pytest.raises(InputError, match=r"not a recording layout CapNav knows. Looked for .*open3d: image/"):
         detect(tmp_path / "x")
+    (tmp_path / "x" / "meta.json").write_text('{"format": "capnav-rgbd"}')
+    with pytest.raises(InputError, match=r"already a capnav-rgbd dataset .* map it directly"):
+        open_recording(tmp_path / "x")
+    (tmp_path / "x.bag").write_bytes(b"#ROSBAG V2.0\n")
+    with pytest.raises(InputError, match=r"is a ROS bag .*capnav import rosbag .* --rgb-topic"):
+        open_recording(tmp_path / "x.bag")
 
 
 ICL = Path(__file__).resolve().parents[2].parent / "shared" / "realdata" / "icl-livingroom1"
