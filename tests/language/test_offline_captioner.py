@@ -52,7 +52,8 @@ def test_an_object_against_a_shared_wall_belongs_to_the_room_it_is_reached_from(
     cabinet = make_obj(2, "cabinet", (3.7, 2.0), (0.75, 0.5, 0.9), (240, 240, 236))  # box reaches x = 4.08
     toilet = make_obj(3, "toilet", (5.0, 1.0), (0.4, 0.6, 0.8), (245, 245, 245))
     bathtub = make_obj(4, "bathtub", (6.8, 3.5), (1.6, 0.7, 0.55), (245, 245, 245))
-    sc = SceneContext([desk, cabinet, toilet, bathtub], grid)
+    chair = make_obj(5, "chair", (1.5, 1.6), (0.45, 0.5, 0.9), (120, 80, 40))  # a desk alone is no sure office
+    sc = SceneContext([desk, cabinet, toilet, bathtub, chair], grid)
     assert sc.room_of(cabinet) == "office" and sc.room_of(toilet) == "bathroom"
 
 

@@ -234,13 +234,14 @@ def test_a_colour_word_accepts_the_shades_it_covers_and_refuses_the_others(emb):
 
 
 def test_a_room_refuses_only_where_its_evidence_is_confident(emb):
-    # Left of the wall a desk, a chair and a wardrobe (no bed): the desk types that room "office",
-    # but the wardrobe is a bedroom cue where the desk stands. Right of it a living room.
+    # Left of the wall a desk, a chair, a bookshelf and a wardrobe (no bed): they type that room
+    # "office", but the wardrobe is a bedroom cue where the desk stands. Right of it a living room.
     objs = [make_obj(1, "desk", (1.0, 0.5), (1.2, 0.6, 0.75), (120, 80, 40)),
             make_obj(2, "chair", (1.0, 1.3), (0.5, 0.5, 0.9), (40, 40, 40)),
             make_obj(3, "wardrobe", (3.5, 0.4), (1.4, 0.6, 2.0), (180, 140, 90)),
             make_obj(4, "sofa", (8.0, 0.6), (2.0, 0.9, 0.8), (128, 128, 128)),
-            make_obj(5, "armchair", (8.0, 3.0), (0.8, 0.8, 0.9), (40, 70, 170))]
+            make_obj(5, "armchair", (8.0, 3.0), (0.8, 0.8, 0.9), (40, 70, 170)),
+            make_obj(6, "bookshelf", (0.2, 2.5), (0.9, 0.35, 1.8), (120, 80, 40))]
     grid = grid_with_wall(-0.5, -0.5, 10.5, 4.0, wall_x=5.0, door=(1.5, 2.5))
     r = Retriever(captioned_map(objs, emb, grid), emb)
     assert r.scene.rooms[0] == "office"

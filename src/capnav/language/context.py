@@ -67,11 +67,14 @@ class ContextConfig:
     min_room_m2: float = 1.0  # m² of eroded core below which a region is not a room of its own
     region_strong: float = 0.9  # noisy-or cue score above which a region clearly is that room type
     open_plan_ratio: float = 0.75  # second room type's cue weight over the first's for an open plan
+    # A region is a room type when P(type | what stands in it) reaches this (``room_prior``; 0.8 is
+    # four to one): a sink alone (kitchen or bathroom) is no room, a sink with a stove a kitchen.
+    room_confidence: float = 0.8
 
 
 #: ``CapNavMap.caches`` key of the stored walls and rooms (written by ``describe_map``).
 CACHE_KEY = "context"
-_SOURCES = (Path(__file__), Path(__file__).with_name("rooms.py"))
+_SOURCES = (Path(__file__), Path(__file__).with_name("rooms.py"), Path(__file__).with_name("room_prior.py"))
 
 
 def canonical_label(label: str) -> str:
@@ -111,6 +114,8 @@ class SceneContext:
         self.gap = np.hypot(gap[..., 0], gap[..., 1])
         self.region = np.full(n, -1, dtype=np.int64)  # room region per object (-1: no walls known)
         self.region_rooms: dict[int, tuple[str | None, dict[str, float]]] = {}
+        self.open_plan: set[int] = set()  # regions whose type is decided per object (two rooms' cues)
+        self.region_confidence: dict[int, float] = {}  # posterior of each region's most probable type
         digest = self._digest()
         if not (self.store is not None and digest and self.store.get("digest") == digest and self._restore(self.store)):
             self.visible = self._line_of_sight()
@@ -143,7 +148,8 @@ class SceneContext:
         """JSON-able walls and rooms (floats round-trip exactly through JSON)."""
         blocked = np.argwhere(np.triu(~self.visible, k=1))
         return {"digest": digest, "blocked": blocked.tolist(), "room_score": self.room_score.tolist(),
-                "region": self.region.tolist(),
+                "region": self.region.tolist(), "open_plan": sorted(self.open_plan),
+                "region_confidence": {str(k): v for k, v in self.region_confidence.items()},
                 "region_rooms": {str(k): [room, scores] for k, (room, scores) in self.region_rooms.items()}}
 
     def _restore(self, d: dict[str, Any]) -> bool:
@@ -153,12 +159,15 @@ class SceneContext:
             region = np.array(d["region"], dtype=np.int64).reshape(n)
             blocked = np.array(d["blocked"], dtype=np.int64).reshape(-1, 2)
             rooms = {int(k): (v[0], {str(r): float(x) for r, x in v[1].items()}) for k, v in d["region_rooms"].items()}
+            open_plan = {int(k) for k in d.get("open_plan", [])}
+            confidence = {int(k): float(v) for k, v in d.get("region_confidence", {}).items()}
             vis = np.ones((n, n), dtype=bool)
             vis[blocked[:, 0], blocked[:, 1]] = False
             vis[blocked[:, 1], blocked[:, 0]] = False
         except (KeyError, TypeError, ValueError, IndexError, AttributeError):
             return False  # not what _stored writes: computed again
         self.visible, self.room_score, self.region, self.region_rooms = vis, score, region, rooms
+        self.open_plan, self.region_confidence = open_plan, confidence
         return True
 
     def _room_scores(self) -> NDArray[np.float64]:
@@ -196,9 +205,12 @@ class SceneContext:
 
     def _regions(self) -> None:
         """Rooms from the free space: each object belongs to the region it is reached from, and a
-        region's type is what its cue objects say together (the most cue weight; its strength the
-        noisy-or of the weights). A region whose cues name two types about equally (an open plan)
-        keeps the per-object distance-based scores."""
+        region's type is the room type most probable given the categories standing in it
+        (``room_prior.room_posterior``, kept in ``region_confidence``), when that reaches
+        ``room_confidence``; else it has none. Its per-type scores stay the cues' noisy-or.
+        A region whose cues name two types about equally (an open plan: a kitchen open to the
+        living room) keeps the per-object distance-based scores."""
+        from capnav.language.room_prior import best_room
         from capnav.language.rooms import object_region, segment_rooms, walkable_domain
 
         assert self.occupancy is not None
@@ -211,20 +223,26 @@ class SceneContext:
                                dtype=np.int64)
         for k in sorted({int(r) for r in self.region} - {-1}):
             members = np.flatnonzero(self.region == k)
-            scores, mass = {}, {}
+            here = [self.labels[i] for i in members]
+            strength, mass = {}, {}
             for room, cues in ROOM_CUES.items():
-                w = [cues[self.labels[i]] for i in members if self.labels[i] in cues]
-                scores[room] = float(1.0 - np.prod([1.0 - x for x in w]))
+                w = [cues[lab] for lab in here if lab in cues]
+                strength[room] = float(1.0 - np.prod([1.0 - x for x in w]))
                 mass[room] = float(sum(w))
             ranked = sorted(mass.items(), key=lambda kv: -kv[1])
-            best = ranked[0][0]
             # Two room types with about as much cue weight (a kitchen open to the living room):
             # an open plan, decided per object by its nearest cues. A desk in a bedroom is not one.
             if len(ranked) > 1 and ranked[1][1] >= self.config.open_plan_ratio * ranked[0][1] \
-                    and scores[ranked[1][0]] >= self.config.region_strong:
-                self.region_rooms[k] = (None, scores)
-            else:
-                self.region_rooms[k] = (best if scores[best] >= self.config.room_min_score else None, scores)
+                    and strength[ranked[1][0]] >= self.config.region_strong and strength[ranked[0][0]] \
+                    >= self.config.region_strong:
+                self.region_rooms[k] = (None, strength)
+                self.open_plan.add(k)
+                continue
+            # The type from the posterior; the per-type cue strengths stay what room constraints weigh
+            # (a wardrobe beside the desk is still a bedroom cue there).
+            room, conf = best_room(here, self.config.room_confidence)
+            self.region_rooms[k] = (room if room in ROOM_CUES else None, strength)
+            self.region_confidence[k] = conf
         for i, reg in enumerate(self.region):
             typed = self.region_rooms.get(int(reg))
             if typed is not None and typed[0] is not None:
@@ -280,11 +298,12 @@ class SceneContext:
         return {room: float(v) for room, v in zip(ROOM_CUES, self.room_score[i], strict=True)}
 
     def _room(self, i: int) -> str | None:
-        typed = self.region_rooms.get(int(self.region[i]))
+        reg = int(self.region[i])
+        typed = self.region_rooms.get(reg)
         if typed is not None and typed[0] is not None:
             return typed[0]
-        if typed is not None and all(v < self.config.room_min_score for v in typed[1].values()):
-            return None  # a region without any cue (a hallway): nearby rooms' cues do not claim it
+        if typed is not None and reg not in self.open_plan:
+            return None  # a region whose contents make no room type sure (a sink alone, a hallway)
         scores = self.room_scores(i)
         room, best = max(scores.items(), key=lambda kv: kv[1])
         return room if best >= self.config.room_min_score else None
