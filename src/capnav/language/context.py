@@ -240,8 +240,8 @@ class SceneContext:
                 continue
             # The type from the posterior; the per-type cue strengths stay what room constraints weigh
             # (a wardrobe beside the desk is still a bedroom cue there).
-            room, conf = best_room(here, self.config.room_confidence)
-            self.region_rooms[k] = (room if room in ROOM_CUES else None, strength)
+            sure, conf = best_room(here, self.config.room_confidence)
+            self.region_rooms[k] = (sure if sure in ROOM_CUES else None, strength)
             self.region_confidence[k] = conf
         for i, reg in enumerate(self.region):
             typed = self.region_rooms.get(int(reg))
