@@ -33,7 +33,7 @@ from capnav.retrieval.query import ParsedQuery
 from capnav.retrieval.ranking import Ranking, keyed_order, semantic_order
 
 if TYPE_CHECKING:
-    from capnav.retrieval.retriever import Retriever
+    from capnav.retrieval.constraints.view import Candidates
 
 for _m in pkgutil.iter_modules(__path__):
     if _m.name != "base":
@@ -50,7 +50,7 @@ def attribute_constraints(q: ParsedQuery) -> list[AttributeConstraint]:
     return [c() for c in ATTRIBUTES if c.applies(q)]
 
 
-def rank(r: Retriever, q: ParsedQuery, s: NDArray[np.float32], robot_xy: tuple[float, float] | None,
+def rank(r: Candidates, q: ParsedQuery, s: NDArray[np.float32], robot_xy: tuple[float, float] | None,
          notes: list[str]) -> tuple[Ranking, RankState]:
     """Apply the ranking constraints, sort, then the ones that read the order (an ordinal)."""
     st = RankState(r, q, s, robot_xy, notes)

@@ -22,8 +22,7 @@ from capnav.retrieval.query import ParsedQuery
 
 if TYPE_CHECKING:
     from capnav.mapping.objects import MapObject
-    from capnav.retrieval.retriever import Retriever
-    from capnav.retrieval.verifier import OfflineVerifier
+    from capnav.retrieval.constraints.view import Candidates, Judge
 
 Status = Literal["supported", "contradicted", "unobserved"]
 SUPPORTED: Status = "supported"
@@ -55,7 +54,7 @@ class RankState:
     ``order_keys`` order within a group before similarity. ``values`` are the numbers each
     constraint measured per pool member (shown as terms)."""
 
-    r: Retriever
+    r: Candidates
     q: ParsedQuery
     s: NDArray[np.float32]
     robot_xy: tuple[float, float] | None
@@ -120,7 +119,7 @@ class AttributeConstraint(ABC):
     def applies(q: ParsedQuery) -> bool: ...
 
     @abstractmethod
-    def judge(self, v: OfflineVerifier, q: ParsedQuery, obj: MapObject, weight: float) -> Evidence:
+    def judge(self, v: Judge, q: ParsedQuery, obj: MapObject, weight: float) -> Evidence:
         """The evidence for ``obj`` (``weight``: 1 for the named category, < 1 for a stand-in)."""
 
 

@@ -19,7 +19,7 @@ from capnav.retrieval.query import ParsedQuery
 
 if TYPE_CHECKING:
     from capnav.mapping.objects import MapObject
-    from capnav.retrieval.verifier import OfflineVerifier
+    from capnav.retrieval.constraints.view import Judge
 
 
 @attribute
@@ -32,7 +32,7 @@ class Colour(AttributeConstraint):
     def applies(q: ParsedQuery) -> bool:
         return bool(q.colors)
 
-    def judge(self, v: OfflineVerifier, q: ParsedQuery, obj: MapObject, weight: float) -> Evidence:
+    def judge(self, v: Judge, q: ParsedQuery, obj: MapObject, weight: float) -> Evidence:
         col, fit, why = v.color_fit(q, obj)
         terms = {"colour": round(col, 3)}
         if not v.observed_colors(q, obj):

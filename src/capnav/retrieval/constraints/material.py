@@ -20,7 +20,7 @@ from capnav.retrieval.query import ParsedQuery
 
 if TYPE_CHECKING:
     from capnav.mapping.objects import MapObject
-    from capnav.retrieval.verifier import OfflineVerifier
+    from capnav.retrieval.constraints.view import Judge
 
 
 @attribute
@@ -33,7 +33,7 @@ class Material(AttributeConstraint):
     def applies(q: ParsedQuery) -> bool:
         return bool(q.materials)
 
-    def judge(self, v: OfflineVerifier, q: ParsedQuery, obj: MapObject, weight: float) -> Evidence:
+    def judge(self, v: Judge, q: ParsedQuery, obj: MapObject, weight: float) -> Evidence:
         mat, why = v.material(q, obj)
         if mat is None:
             return Evidence(self.kind, CONTRADICTED, 0.0, why)

@@ -11,13 +11,13 @@ from capnav.retrieval.query import ParsedQuery
 
 if TYPE_CHECKING:
     from capnav.mapping.objects import MapObject
-    from capnav.retrieval.verifier import OfflineVerifier
+    from capnav.retrieval.constraints.view import Judge
 
 
 class Name:
     kind = "name"
 
-    def judge(self, v: OfflineVerifier, q: ParsedQuery, obj: MapObject) -> Evidence:
+    def judge(self, v: Judge, q: ParsedQuery, obj: MapObject) -> Evidence:
         """``value`` is the category weight: 1 for the named category, < 1 for a stand-in."""
         ok, weight, why = v.name_agreement(q, obj)
         if not ok:

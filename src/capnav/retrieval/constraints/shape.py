@@ -17,7 +17,7 @@ from capnav.retrieval.query import ParsedQuery
 
 if TYPE_CHECKING:
     from capnav.mapping.objects import MapObject
-    from capnav.retrieval.verifier import OfflineVerifier
+    from capnav.retrieval.constraints.view import Judge
 
 
 @attribute
@@ -30,7 +30,7 @@ class Shape(AttributeConstraint):
     def applies(q: ParsedQuery) -> bool:
         return bool(q.shapes)
 
-    def judge(self, v: OfflineVerifier, q: ParsedQuery, obj: MapObject, weight: float) -> Evidence:
+    def judge(self, v: Judge, q: ParsedQuery, obj: MapObject, weight: float) -> Evidence:
         agree, why = v.shape(q, obj)
         if agree is None:
             return Evidence(self.kind, CONTRADICTED, 0.0, why)

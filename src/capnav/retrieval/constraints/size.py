@@ -11,7 +11,7 @@ from capnav.retrieval.query import ParsedQuery
 
 if TYPE_CHECKING:
     from capnav.mapping.objects import MapObject
-    from capnav.retrieval.verifier import OfflineVerifier
+    from capnav.retrieval.constraints.view import Judge
 
 
 @attribute
@@ -24,6 +24,6 @@ class Size(AttributeConstraint):
     def applies(q: ParsedQuery) -> bool:
         return q.size_word is not None
 
-    def judge(self, v: OfflineVerifier, q: ParsedQuery, obj: MapObject, weight: float) -> Evidence:
+    def judge(self, v: Judge, q: ParsedQuery, obj: MapObject, weight: float) -> Evidence:
         size = v.size(q, obj)
         return Evidence(self.kind, UNOBSERVED if size == 0.5 else SUPPORTED, size, "", {"size": round(size, 3)})
