@@ -67,3 +67,13 @@ def test_tall_objects_are_labelled_with_their_height(tmp_path) -> None:  # type:
         matplotlib.text.Text.__init__ = orig  # type: ignore[method-assign]
     assert out.stat().st_size > 1000
     assert "22 wardrobe\n2.0 m tall" in seen and "15 stool" in seen
+
+
+def test_a_ragged_corner_hull_keeps_the_box_on_its_faces() -> None:
+    """A fridge's hull as the map measured it: two faces in many short, slightly bent edges and the
+    unseen diagonal; the box lies on the faces, not on the diagonal (whose rectangle is 5% smaller)."""
+    hull = np.array([[7.58, 4.0], [6.86, 3.21], [6.87, 3.21], [7.02, 3.21], [7.47, 3.21], [7.58, 3.21],
+                     [7.59, 3.29], [7.61, 3.57], [7.61, 3.67], [7.59, 3.9]])
+    rect = min_area_rectangle(hull)
+    assert np.allclose(sorted(map(tuple, rect.round(2))), sorted([(6.86, 3.21), (7.61, 3.21), (7.61, 4.0),
+                                                                  (6.86, 4.0)]))

@@ -49,7 +49,7 @@ def object_height(obj: MapObject) -> float:
 
 def min_area_rectangle(pts: NDArray[np.float64]) -> NDArray[np.float64]:
     """The 4 corners of the smallest rectangle enclosing the convex polygon ``pts`` (rotating calipers:
-    one side of it lies on an edge of the hull). Of rectangles within 5% of the smallest, the one
+    one side of it lies on an edge of the hull). Of rectangles within 15% of the smallest, the one
     whose sides carry most of the hull's perimeter: a box seen from a corner has a triangular hull of
     equal-area rectangles on its two seen faces and on the unseen diagonal, and the faces are what
     was observed."""
@@ -62,11 +62,11 @@ def min_area_rectangle(pts: NDArray[np.float64]) -> NDArray[np.float64]:
         q = pts @ rot.T
         lo, hi = q.min(axis=0), q.max(axis=0)
         gap = np.abs((dirs - a + np.pi / 4) % (np.pi / 2) - np.pi / 4)  # edge angle to the sides, mod 90 deg
-        on_sides = float(lengths[gap < np.radians(3.0)].sum())
+        on_sides = float(lengths[gap < np.radians(10.0)].sum())
         corners = np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])
         cands.append((float(np.prod(hi - lo)), on_sides, corners @ rot))
     smallest = min(c[0] for c in cands)
-    return max((c for c in cands if c[0] <= 1.05 * smallest), key=lambda c: c[1])[2]
+    return max((c for c in cands if c[0] <= 1.15 * smallest), key=lambda c: c[1])[2]
 
 
 def _polygon_area(p: NDArray[np.float64]) -> float:
