@@ -61,10 +61,12 @@ def table(runs: list[tuple[str, dict[str, Any]]], protocol: str) -> list[str]:
     if not methods:
         return []
     mean = len(runs) > 1
-    head = "| Method | " + " | ".join(f"{label}: indep. [95% CI] / strict / 4 in a row" for label, _ in runs) \
+    head = "| Method | " + " | ".join(f"{label}: indep. [95% CI] / strict / strict in its room / 4 in a row"
+                                      for label, _ in runs) \
         + (" | mean indep. of the runs |" if mean else " |")
     lines = [f"**{protocol}** (subgoal success %, paper rule with its bootstrap 95% interval over episodes / strict; "
-             "full 4-subgoal chains, paper rule)", "", head, "|---|" + "---:|" * (len(runs) + mean)]
+             "strict and stopped in the object's room; full 4-subgoal chains, paper rule)", "", head,
+             "|---|" + "---:|" * (len(runs) + mean)]
     for m in methods:
         cells = []
         for b in by:
@@ -72,7 +74,7 @@ def table(runs: list[tuple[str, dict[str, Any]]], protocol: str) -> list[str]:
             ci = s.get("independent_ci") if s is not None else None
             cells.append("–" if s is None else
                          f"{pct(s['independent'])}" + (f" [{pct(ci[0])}-{pct(ci[1])}]" if ci else "")
-                         + f" / {pct(s.get('independent_strict'))} / "
+                         + f" / {pct(s.get('independent_strict'))} / {pct(s.get('independent_room'))} / "
                          f"{pct(s['in_a_row'][-1] if s['in_a_row'] else None)}")
         if mean:
             vals = [b[m]["independent"] for b in by if m in b]

@@ -87,3 +87,17 @@ def test_starts_keep_the_planners_margin_and_a_way_out() -> None:
     ok = start_cells(clearance, inside, 0.3)
     assert ok[20, 20] and not ok[20, 60] and not ok[2, 20]  # the room's middle; not the pocket, not by a wall
     assert (clearance[ok] > 0.3).all()
+
+
+def test_strict_in_the_objects_room_needs_the_stop_in_its_room() -> None:
+    from capnav.sim.sightline import SightGrid
+
+    spec = GridSpec(0.0, 0.0, 0.1, 40, 80)
+    truth = SceneTruth(0, {1: "sofa"}, {1: np.array([[3.3, 1.0], [3.8, 1.0], [3.8, 1.5], [3.3, 1.5]])}, spec,
+                       np.ones((40, 80), bool), sight=SightGrid(spec, np.zeros((40, 80), np.int32)),
+                       rooms=[np.array([[0, 0], [3, 0], [3, 4], [0, 4]], float),
+                              np.array([[3, 0], [8, 0], [8, 4], [3, 4]], float)])
+    assert truth.room_of((1.0, 1.0)) == 0 and truth.room_of((5.0, 1.0)) == 1 and truth.room_of((9.0, 1.0)) == -1
+    assert truth.in_goal_room((3.9, 1.2), [1]) is True
+    assert truth.in_goal_room((2.8, 1.2), [1]) is False  # within 1 m and in sight (no wall drawn) but next door
+    assert truth.sees_goal((2.8, 1.2), [1]) is True

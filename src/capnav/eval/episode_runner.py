@@ -94,18 +94,20 @@ def run_episode(method: NavMethod, ctx: SceneContext, episode: Episode, truth: S
         if goal.absent:  # the right answer is "not found": success is a refusal, wherever the agent is
             success: bool = not out.found
             strict: bool | None = success if truth.sight is not None else None
+            room: bool | None = success if truth.sight is not None and truth.rooms else None
             judged: bool | None = not out.found
             shortest = 0.0
         else:
             success = bool(dist <= truth.radius)
             strict = truth.sees_goal(stop_xy, goal.target_ids)
+            room = truth.in_goal_room(stop_xy, goal.target_ids)
             judged = retrieval_correct(truth, out.target_xy, goal.target_ids)
             shortest = truth.field(goal.target_ids).at(start_xy)
         traj = _trajectory(agent)[max(traj0 - 1, 0):] or [start_xy, stop_xy]
         records.append(SubgoalRecord(
             method=method.name, protocol=protocol, scene_seed=episode.scene_seed, episode_id=episode.id, index=i,
             text=goal.text, category=goal.category, target_ids=list(goal.target_ids), kind=goal.kind,
-            success=success, distance_to_goal=dist, success_strict=strict,
+            success=success, distance_to_goal=dist, success_strict=strict, success_room=room,
             path_length=max(_odometry(agent) - odo0, 0.0),
             shortest_path=shortest,
             start_xy=start_xy, stop_xy=stop_xy, found=bool(out.found),

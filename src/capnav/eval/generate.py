@@ -67,6 +67,7 @@ class SceneTruth:
     radius: float = SUCCESS_RADIUS_M
     sight: SightGrid | None = None  # walls and tall objects, for the strict (line-of-sight) success rule
     starts: NDArray[np.bool_] | None = None  # where a start may be drawn (default: every navigable cell)
+    rooms: list[NDArray[np.float64]] | None = None  # room polygons, for the "in the object's room" rule
     _fields: dict[tuple[int, ...], DistanceField] = field(default_factory=dict, repr=False)
 
     @classmethod
@@ -77,7 +78,8 @@ class SceneTruth:
         return cls(int(manifest.seed), {o.id: o.category for o in objs},  # type: ignore[attr-defined]
                    {o.id: np.asarray(o.footprint, dtype=np.float64) for o in objs}, spec,
                    np.asarray(navigable, dtype=bool), radius, sight,
-                   None if starts is None else np.asarray(starts, dtype=bool))
+                   None if starts is None else np.asarray(starts, dtype=bool),
+                   rooms=[np.asarray(r.polygon, dtype=np.float64) for r in getattr(manifest, "rooms", [])] or None)
 
     def sees_goal(self, xy: tuple[float, float], target_ids: Sequence[int]) -> bool | None:
         """Strict success's second half: is one of the goal instances within ``radius`` AND in sight
@@ -87,6 +89,28 @@ class SceneTruth:
         for t in target_ids:
             fp = self.footprints[t]
             if footprint_distance(np.asarray(xy, dtype=np.float64).reshape(1, 2), fp)[0] <= self.radius \
+                    and self.sight.sees(xy, fp, own_ids=(t,)):
+                return True
+        return False
+
+    def room_of(self, xy: Sequence[float] | NDArray[np.floating]) -> int:
+        """Index of the room polygon holding ``xy`` (-1 outside every room or without rooms)."""
+        p = np.asarray(xy, dtype=np.float64).reshape(1, 2)
+        for k, poly in enumerate(self.rooms or []):
+            if footprint_distance(p, poly)[0] == 0.0:
+                return k
+        return -1
+
+    def in_goal_room(self, xy: tuple[float, float], target_ids: Sequence[int]) -> bool | None:
+        """The strict rule with the room: a goal instance within ``radius``, in sight, and in the
+        room the stop point is in (None without sight grid or rooms)."""
+        if self.sight is None or not self.rooms:
+            return None
+        here = self.room_of(xy)
+        for t in target_ids:
+            fp = self.footprints[t]
+            if here >= 0 and self.room_of(fp.mean(axis=0)) == here \
+                    and footprint_distance(np.asarray(xy, dtype=np.float64).reshape(1, 2), fp)[0] <= self.radius \
                     and self.sight.sees(xy, fp, own_ids=(t,)):
                 return True
         return False

@@ -56,6 +56,8 @@ class SubgoalRecord:
     #: Strict rule: within 1 m of a goal instance AND in sight of it (no wall or tall object between);
     #: None for records made without the scene's sight grid.
     success_strict: bool | None = None
+    #: The strict rule and the stop point in the goal instance's room; None without room truth.
+    success_room: bool | None = None
 
     @property
     def spl(self) -> float:
@@ -115,6 +117,8 @@ class Summary:
     independent_strict: float | None = None
     #: Bootstrap 95% interval of ``independent`` (episodes resampled: subgoals of one episode share a start).
     independent_ci: list[float] | None = None
+    #: Strict and in the object's room (the stop point in the room the object stands in).
+    independent_room: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -195,6 +199,8 @@ def summarize(records: Sequence[SubgoalRecord]) -> Summary:
         in_a_row_strict=in_a_row(chains_of(records, strict=True)) if has_strict else None,
         independent_strict=float(np.mean([bool(r.success_strict) for r in records])) if has_strict else None,
         independent_ci=bootstrap_ci(chains),
+        independent_room=float(np.mean([bool(r.success_room) for r in records]))
+        if all(r.success_room is not None for r in records) else None,
     )
 
 
