@@ -3,7 +3,7 @@
 Why: people single objects out by shape ("the round table", "the L-shaped sofa", "the leafy
 plant", "the cactus"), and the map holds each object's points. Every rule here reads only those points
 (world frame, z up); its thresholds are measured by ``benchmarks/measure_evidence.py`` against
-the simulator's shape variants and said in the README (issue 12). A word is said only when its
+the simulator's shape variants and listed in docs/benchmarks.md. A word is said only when its
 measure is clearly on one side; a verifier refuses only a word that contradicts a said one.
 
 Not said: whether a sofa's arms are rolled ("curved") or boxed. The fall of the arm tops towards

@@ -21,7 +21,7 @@ lightness) is within ``color_tolerance`` of the object's median observed colour,
 strong edges (the borders between faces and parts). Each view gives the RMS of the two bands over
 those pixels; the object's value is the median over views. With too few pixels, or a ratio between
 the two thresholds, nothing is said. The thresholds are measured by
-``benchmarks/measure_evidence.py`` against the simulator's materials (README, issue 12).
+``benchmarks/measure_evidence.py`` against the simulator's materials (docs/benchmarks.md).
 """
 
 from __future__ import annotations
