@@ -198,7 +198,11 @@ class Retriever:
         runners = self._runners_up(rk, s, judged, chosen_i)
         dist, dist_kind = None, "straight"
         if robot_xy is not None and chosen_i is not None:
-            d, dist_kind = self.robot_distance(robot_xy)
+            # Measured as the ranking measured it: a walk (cached by the distance constraint) when
+            # the answer was ranked by distance, else eq. 17's straight grid distance, so that a
+            # sentence's distance never costs a search over the whole floor.
+            d, dist_kind = self.robot_distance(robot_xy) if mode == "closest" \
+                else (self.grid_distance(robot_xy), "straight")
             dist = float(d[chosen_i])
         reason = self._explain(q, chosen_i, s, rk, notes, verdict_reason, dist, verifier, runners, judged,
                                dist_kind)
