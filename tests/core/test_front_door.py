@@ -14,20 +14,11 @@ import sys
 from pathlib import Path
 
 import pytest
-
-from capnav.cli import main
+from _cli import cli
 
 REPO = Path(__file__).resolve().parents[2]
 
 
-def cli(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, *args: str) -> tuple[int, str]:
-    monkeypatch.setattr(sys, "argv", ["capnav", *args])
-    capsys.readouterr()
-    with pytest.raises(SystemExit) as ex:
-        main()
-    err = capsys.readouterr().err
-    assert "Traceback" not in err, err
-    return int(ex.value.code or 0), err
 
 
 def one_error(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, *args: str) -> str:
