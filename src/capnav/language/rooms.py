@@ -8,12 +8,10 @@ covers. The grid's one-cell unsampled gaps are closed first (``fill_gaps``).
 
 from __future__ import annotations
 
-import heapq
-
-import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from capnav.core.geodesic import grid_geodesic
 from capnav.core.grid import FREE, OCCUPIED, UNKNOWN, GridSpec, OccupancyGrid
 
 
@@ -59,36 +57,6 @@ def walkable_domain(occ: OccupancyGrid, boxes_lo: NDArray[np.float64], boxes_hi:
     return dom
 
 
-@numba.njit(cache=True)
-def _dijkstra(domain: NDArray[np.bool_], seeds: NDArray[np.int64], limit: float) -> NDArray[np.float64]:
-    rows, cols = domain.shape
-    dist = np.full((rows, cols), np.inf)
-    heap = [(0.0, np.int64(0), np.int64(0))]
-    heap.pop()
-    for k in range(seeds.shape[0]):
-        r, c = seeds[k, 0], seeds[k, 1]
-        dist[r, c] = 0.0
-        heap.append((0.0, r, c))
-    heapq.heapify(heap)
-    dr = np.array([-1, -1, -1, 0, 0, 1, 1, 1])
-    dc = np.array([-1, 0, 1, -1, 1, -1, 0, 1])
-    w = np.array([1.4142135623730951, 1.0, 1.4142135623730951, 1.0, 1.0, 1.4142135623730951, 1.0,
-                  1.4142135623730951])
-    while len(heap) > 0:
-        d, r, c = heapq.heappop(heap)
-        if d > dist[r, c] or d > limit:
-            continue
-        for k in range(8):
-            rr, cc = r + dr[k], c + dc[k]
-            if rr < 0 or cc < 0 or rr >= rows or cc >= cols or not domain[rr, cc]:
-                continue
-            nd = d + w[k]
-            if nd < dist[rr, cc]:
-                dist[rr, cc] = nd
-                heapq.heappush(heap, (nd, rr, cc))
-    return dist
-
-
 def geodesic_from_boxes(domain: NDArray[np.bool_], spec: GridSpec, los: NDArray[np.floating],
                         his: NDArray[np.floating], limit_m: float = 12.0) -> NDArray[np.float64]:
     """Metres from the nearest of several boxes to every cell through ``domain`` (inf where
@@ -106,7 +74,7 @@ def geodesic_from_boxes(domain: NDArray[np.bool_], spec: GridSpec, los: NDArray[
     seeds = seeds[domain[seeds[:, 0], seeds[:, 1]]]
     if len(seeds) == 0:
         return np.full(domain.shape, np.inf)
-    return _dijkstra(domain, seeds, limit_m / spec.resolution) * spec.resolution
+    return grid_geodesic(domain, seeds, limit_m / spec.resolution) * spec.resolution
 
 
 def box_min(field: NDArray[np.float64], spec: GridSpec, lo: NDArray[np.floating], hi: NDArray[np.floating],
@@ -144,7 +112,7 @@ def segment_rooms(domain: NDArray[np.bool_], spec: GridSpec, door_width: float =
     k = 0
     for j in np.flatnonzero(sizes >= min_core_m2):
         rr, cc = np.nonzero(lab == j + 1)
-        d = _dijkstra(domain, np.stack([rr, cc], axis=1).astype(np.int64), np.inf)
+        d = grid_geodesic(domain, np.stack([rr, cc], axis=1).astype(np.int64), np.inf)
         closer = d < best
         labels[closer] = k
         best[closer] = d[closer]

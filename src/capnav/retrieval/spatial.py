@@ -14,11 +14,15 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from capnav.core.geodesic import box_minima
 from capnav.core.grid import OCCUPIED, OccupancyGrid
+from capnav.language.rooms import box_cells, fill_gaps, geodesic_from_boxes
 
 #: Below this length / width ratio a footprint has no long axis, so no "end" (a round or square
 #: table): "at the end of" is then read as "next to".
 MIN_ELONGATION = 1.25
+#: An object whose own cells no walk reaches is measured at the ring of cells around it (m).
+RING = 0.3
 
 
 def segment_distance(p: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
@@ -84,8 +88,6 @@ class FloorDistances:
 
     def __init__(self, occ: OccupancyGrid, los: NDArray[np.float64], his: NDArray[np.float64],
                  cache_size: int = 8) -> None:
-        from capnav.language.rooms import fill_gaps
-
         self.spec = occ.spec
         self.los = np.asarray(los, dtype=np.float64).reshape(-1, 2)
         self.his = np.asarray(his, dtype=np.float64).reshape(-1, 2)
@@ -94,21 +96,24 @@ class FloorDistances:
             (r0, c0), (r1, c1) = self.spec.to_cell(lo), self.spec.to_cell(hi)
             dom[max(r0, 0):max(r1 + 1, 0), max(c0, 0):max(c1 + 1, 0)] = True
         self.domain = dom
+        # Each object's cells and its cells grown by RING, once per map (read by every search).
+        self._boxes = np.array([box_cells(self.spec, lo, hi) for lo, hi in zip(self.los, self.his, strict=True)],
+                               dtype=np.int64).reshape(-1, 4)
+        self._grown = np.array([box_cells(self.spec, lo - RING, hi + RING)
+                                for lo, hi in zip(self.los, self.his, strict=True)], dtype=np.int64).reshape(-1, 4)
         self._cache: dict[tuple[int, ...], NDArray[np.float64]] = {}
         self._size = cache_size
 
     def _per_object(self, key: tuple[int, ...], los: NDArray[np.float64], his: NDArray[np.float64]
                     ) -> NDArray[np.float64]:
-        if key in self._cache:
-            return self._cache[key]
-        from capnav.language.rooms import box_min, geodesic_from_boxes
-
-        field = geodesic_from_boxes(self.domain, self.spec, los, his, limit_m=np.inf)
-        out = np.array([box_min(field, self.spec, lo, hi) for lo, hi in zip(self.los, self.his, strict=True)])
-        if len(self._cache) >= self._size:
-            self._cache.pop(next(iter(self._cache)))
-        self._cache[key] = out
-        return out
+        hit = self._cache.pop(key, None)
+        if hit is None:
+            field = geodesic_from_boxes(self.domain, self.spec, los, his, limit_m=np.inf)
+            hit = box_minima(field, self._boxes, self._grown, RING)
+            if len(self._cache) >= self._size:
+                self._cache.pop(next(iter(self._cache)))  # the least recently used source
+        self._cache[key] = hit
+        return hit
 
     def from_point(self, xy: tuple[float, float]) -> NDArray[np.float64]:
         """Metres along the floor from ``xy`` to each object (inf when no walk reaches it)."""

@@ -1,0 +1,119 @@
+"""The bucket-queue walking distance gives the very floats of a heap-ordered Dijkstra (the routine
+it replaced, kept here in plain Python as the reference), with and without a distance limit, and
+walking distances to objects keep their order where it differs from the straight line."""
+
+from __future__ import annotations
+
+import heapq
+import math
+
+import numpy as np
+import pytest
+
+from capnav.core.geodesic import box_minima, grid_geodesic
+from capnav.core.grid import FREE, OCCUPIED, GridSpec, OccupancyGrid
+from capnav.language.rooms import box_cells, box_min
+from capnav.retrieval.spatial import RING, FloorDistances
+
+_MOVES = [(-1, -1, math.sqrt(2)), (-1, 0, 1.0), (-1, 1, math.sqrt(2)), (0, -1, 1.0), (0, 1, 1.0),
+          (1, -1, math.sqrt(2)), (1, 0, 1.0), (1, 1, math.sqrt(2))]
+
+
+def heap_dijkstra(domain: np.ndarray, seeds: np.ndarray, limit: float) -> np.ndarray:
+    """The replaced routine: a binary heap, no closed set, cells past ``limit`` not expanded."""
+    rows, cols = domain.shape
+    dist = np.full((rows, cols), np.inf)
+    heap: list[tuple[float, int, int]] = []
+    for r, c in seeds:
+        dist[r, c] = 0.0
+        heap.append((0.0, int(r), int(c)))
+    heapq.heapify(heap)
+    while heap:
+        d, r, c = heapq.heappop(heap)
+        if d > dist[r, c] or d > limit:
+            continue
+        for dr, dc, w in _MOVES:
+            rr, cc = r + dr, c + dc
+            if 0 <= rr < rows and 0 <= cc < cols and domain[rr, cc] and d + w < dist[rr, cc]:
+                dist[rr, cc] = d + w
+                heapq.heappush(heap, (d + w, rr, cc))
+    return dist
+
+
+def rooms_with_doors(rng: np.random.Generator, rows: int, cols: int) -> np.ndarray:
+    dom = rng.random((rows, cols)) > 0.12  # scattered clutter
+    for c in rng.choice(np.arange(3, cols - 3), size=2, replace=False):
+        dom[:, c] = False
+        r = int(rng.integers(0, rows - 3))
+        dom[r:r + 3, c] = True
+    r = int(rng.integers(3, rows - 3))
+    dom[r, : cols // 2] = False  # a closed-off pocket may leave cells unreachable
+    return dom
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+@pytest.mark.parametrize("limit", [math.inf, 7.5])
+def test_same_floats_as_the_heap_dijkstra(seed: int, limit: float) -> None:
+    rng = np.random.default_rng(seed)
+    dom = rooms_with_doors(rng, 23, 31)
+    free = np.argwhere(dom)
+    seeds = free[rng.choice(len(free), size=1 + seed, replace=False)].astype(np.int64)
+    got = grid_geodesic(dom, seeds, limit)
+    ref = heap_dijkstra(dom, seeds, limit)
+    assert np.isinf(ref).any()  # walls and the pocket leave unreachable cells (limit or not)
+    np.testing.assert_array_equal(got, ref)
+
+
+def test_a_seed_outside_the_domain_still_starts_the_walk_and_duplicates_are_harmless() -> None:
+    dom = np.ones((6, 7), dtype=bool)
+    dom[2, 3] = False
+    seeds = np.array([[2, 3], [2, 3], [0, 0]], dtype=np.int64)
+    np.testing.assert_array_equal(grid_geodesic(dom, seeds, math.inf), heap_dijkstra(dom, seeds, math.inf))
+
+
+def test_box_minima_match_the_per_box_loop() -> None:
+    rng = np.random.default_rng(5)
+    spec = GridSpec(0.0, 0.0, 0.1, 40, 50)
+    dom = rooms_with_doors(rng, 40, 50)
+    field = grid_geodesic(dom, np.array([[5, 5]], np.int64), math.inf) * spec.resolution
+    los = rng.uniform([-0.5, -0.5], [4.5, 3.5], (60, 2))
+    his = los + rng.uniform(0.05, 1.0, (60, 2))
+    boxes = np.array([box_cells(spec, lo, hi) for lo, hi in zip(los, his, strict=True)], np.int64)
+    grown = np.array([box_cells(spec, lo - RING, hi + RING) for lo, hi in zip(los, his, strict=True)], np.int64)
+    got = box_minima(field, boxes, grown, RING)
+    ref = np.array([box_min(field, spec, lo, hi, RING) for lo, hi in zip(los, his, strict=True)])
+    np.testing.assert_array_equal(got, ref)
+    assert 10 < np.isfinite(ref).sum() < len(ref)  # reached boxes and boxes no walk reaches
+
+
+def test_walking_order_differs_from_the_straight_line_and_matches_the_reference() -> None:
+    # A 6 x 4 m room split by a wall at x = 3 with its door at the far north end: object 0 is 1 m
+    # from the robot through the wall, object 1 is 2.5 m away on the robot's own side.
+    spec = GridSpec(0.0, 0.0, 0.1, 40, 60)
+    cells = np.full((40, 60), FREE, np.uint8)
+    cells[:34, 29:31] = OCCUPIED
+    occ = OccupancyGrid(spec, cells)
+    los = np.array([[3.4, 0.8], [0.3, 2.2]])
+    his = los + 0.4
+    robot = (2.4, 1.0)
+    floor = FloorDistances(occ, los, his)
+    d = floor.from_point(robot)
+    line = np.hypot(*((los + his) / 2 - robot).T)
+    assert np.argmin(line) == 0 and np.argmin(d) == 1
+    rc = spec.to_cell(np.asarray(robot))
+    ref_field = heap_dijkstra(floor.domain, np.array([rc], np.int64), math.inf) * spec.resolution
+    ref = np.array([box_min(ref_field, spec, lo, hi) for lo, hi in zip(los, his, strict=True)])
+    np.testing.assert_array_equal(d, ref)
+    assert floor.from_point(robot) is d  # cached per source cell
+    np.testing.assert_array_equal(floor.from_objects(np.array([1])), floor.from_objects(np.array([1])))
+
+
+def test_the_cache_keeps_the_most_recently_used_sources() -> None:
+    spec = GridSpec(0.0, 0.0, 0.1, 20, 20)
+    occ = OccupancyGrid(spec, np.full((20, 20), FREE, np.uint8))
+    floor = FloorDistances(occ, np.array([[0.5, 0.5]]), np.array([[0.7, 0.7]]), cache_size=2)
+    a = floor.from_point((1.0, 1.0))
+    floor.from_point((1.5, 1.5))
+    assert floor.from_point((1.0, 1.0)) is a  # used again: now the most recent
+    floor.from_point((0.2, 1.8))  # evicts (1.5, 1.5), the least recently used
+    assert floor.from_point((1.0, 1.0)) is a
