@@ -25,8 +25,8 @@ import numpy as np
 
 from capnav.core.footprint import footprint_distance
 from capnav.core.grid import FREE, OccupancyGrid
-from capnav.eval.success import SUCCESS_RADIUS_M
 from capnav.planning import PlannerConfig, build_costmap, navigate_to
+from capnav.sim.success import SUCCESS_RADIUS_M
 
 TARGET = {"truth": 0.99, "mapped": 0.95}
 

@@ -2,7 +2,7 @@
 
 For each apartment seed: record the exploration pass (``capnav sim`` defaults), map it with the
 simulator detector at its default noise, describe the map with the offline captioner and the
-MiniLM embedder, then ask generated instructions (``capnav.eval.instructions``) and score the
+MiniLM embedder, then ask generated instructions (``capnav.sim.instructions``) and score the
 answers against the scene truth. A chosen object counts as an instance when most of its points
 lie inside that instance's box (the rule of ``capnav.eval.map_quality``).
 
@@ -19,7 +19,6 @@ from pathlib import Path
 
 import numpy as np
 
-from capnav.eval.instructions import KINDS, Instruction, generate_instructions
 from capnav.eval.map_quality import inside_box
 from capnav.io.dataset import DatasetReader
 from capnav.io.mapfile import load_map, save_map
@@ -29,6 +28,7 @@ from capnav.mapping.cmap import CapNavMap
 from capnav.mapping.objects import MapObject
 from capnav.perception import create_detector, create_encoder
 from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
+from capnav.sim.instructions import KINDS, Instruction, generate_instructions
 from capnav.sim.manifest import SceneManifest
 from capnav.sim.record import record_dataset
 

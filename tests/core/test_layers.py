@@ -5,7 +5,7 @@ every ``import`` counts, at module level, inside functions and under ``TYPE_CHEC
   import neither the simulator (``sim``: the scene truth) nor the evaluation (``eval``), nor
   anything built on top of them;
 - ``core`` imports only ``core``; ``sim`` (the world) imports no stage that builds or reads maps;
-- the product pipeline (``pipeline``), the library face (``api``) and the server (``serve``)
+- the product pipeline (``pipeline``), the library face (``api``), the demo and the server (``serve``)
   never import ``eval``;
 - no import circles between modules.
 """
@@ -26,6 +26,7 @@ FORBIDDEN: dict[str, tuple[str, ...]] = {
     "core": tuple(t for t in TOP if t != "core"),
     "sim": ("mapping", "language", "retrieval", "planning", *ABOVE),
     "pipeline": ("eval", "demo", "cli", "serve", "api"),
+    "demo": ("eval", "cli", "serve"),
     "api": ("eval", "demo", "cli", "serve"),
     "serve": ("eval", "demo", "cli", "sim"),
     "viz": ("eval", "demo", "cli", "serve", "pipeline"),  # it draws the api's answers
@@ -135,7 +136,8 @@ def test_the_checker_sees_lazy_and_type_checking_imports() -> None:
 
 
 #: What a user runs to navigate: none of it may reach the evaluation, directly or through another module.
-NAVIGATING = ("capnav.cli.navigate", "capnav.api", "capnav.serve", "capnav.pipeline.drive")
+NAVIGATING = ("capnav.cli.navigate", "capnav.cli.demo", "capnav.demo", "capnav.api", "capnav.serve",
+              "capnav.pipeline.drive")
 
 
 def test_navigating_never_reaches_the_evaluation() -> None:

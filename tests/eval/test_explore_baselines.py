@@ -25,12 +25,12 @@ from capnav.eval.baselines.explore.sighting import Sighting
 from capnav.eval.baselines.explore.topo_graph import GraphConfig, build_graph
 from capnav.eval.baselines.explore.zson import ZSONConfig, ZSONMethod
 from capnav.eval.method import METHODS, SceneContext, SubgoalOutcome, create_method, load_methods
-from capnav.eval.success import distance_to_instances
 from capnav.language import create_embedder
 from capnav.perception import create_detector
 from capnav.planning import PlannerConfig, build_costmap
 from capnav.planning.search import cost_field
 from capnav.sim import CameraConfig, ExploreConfig, LayoutConfig, SimConfig, Simulator, explore
+from capnav.sim.success import distance_to_instances
 
 SCENE = 0  # 3 rooms, 8.4 x 6.2 m; no stove in it
 

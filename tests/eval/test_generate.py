@@ -71,7 +71,7 @@ def test_unreachable_scene_is_a_clear_error() -> None:
 
 
 def test_starts_keep_the_planners_margin_and_a_way_out() -> None:
-    from capnav.eval.generate import start_cells
+    from capnav.sim.navgrid import start_cells
 
     # A 2 m room (clearance grows from its walls) with a pocket joined to it by a neck whose
     # clearance is the robot's radius only: the pocket is navigable but no start is drawn there.

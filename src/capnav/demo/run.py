@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 from rich.console import Console
 from rich.markup import escape
 
@@ -24,13 +25,13 @@ from capnav.core.grid import FREE
 from capnav.core.limits import check_count, check_image_size
 from capnav.core.text import shorten
 from capnav.demo.report import Report, ReportItem, verdict, write_html, write_markdown
-from capnav.eval.generate import SceneTruth, start_cells
-from capnav.eval.success import SUCCESS_RADIUS_M, distance_to_instances
 from capnav.mapping.objects import MapObject
 from capnav.pipeline import PipelineConfig, SimScene, open_sim_scene
 from capnav.pipeline.drive import run_instruction
 from capnav.planning import PlannerConfig
 from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
+from capnav.sim.navgrid import start_cells
+from capnav.sim.success import SUCCESS_RADIUS_M, distance_to_instances
 
 #: One instruction of each kind by default: what CapNav is for first, then the classic cases.
 DEFAULT_KINDS = ("attribute", "superlative", "relation", "closest", "room", "category", "absent")
@@ -76,7 +77,7 @@ def _next_instruction(cfg: DemoConfig, k: int, sim: Any, robot_xy: tuple[float, 
     from where the robot stands now (so that "closest" means closest to the robot when it is asked)."""
     if cfg.instructions:
         return (cfg.instructions[k], "user", [])
-    from capnav.eval.instructions import generate_instructions
+    from capnav.sim.instructions import generate_instructions
 
     made = generate_instructions(sim.manifest, per_kind=1, seed=cfg.seed * 1000 + k, kinds=(cfg.kinds[k],),
                                  robot_xy=robot_xy)
@@ -96,10 +97,9 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
     assets = open_sim_scene(cfg.seed, cfg.seed, pcfg, out)  # the product pipeline: it never reads the truth
     sim = assets.sim
     nav_truth = sim.navigable()  # the simulator's truth: only to pick starts and instructions and to judge
-    truth = SceneTruth.from_manifest(
-        sim.manifest, nav_truth.spec, nav_truth.cells == FREE,
-        starts=start_cells(sim.nav_grid().clearance, nav_truth.cells == FREE,
-                           PlannerConfig().inflation + nav_truth.spec.resolution))
+    starts = start_cells(sim.nav_grid().clearance, nav_truth.cells == FREE,
+                         PlannerConfig().inflation + nav_truth.spec.resolution)
+    footprints = {o.id: np.asarray(o.footprint, dtype=np.float64) for o in sim.manifest.objects}
     con.print(f"     {len(sim.manifest.rooms)} rooms, {len(sim.manifest.objects)} objects "
               f"({time.perf_counter() - t0:.1f} s)")
     from capnav.viz.scene import draw_scene
@@ -116,8 +116,12 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
 
     retriever = Retriever(cmap, assets.embedder, create_verifier(cfg.verifier), RetrievalConfig())
     rng = np.random.default_rng(cfg.seed + 1)
-    start = truth.sample_start(rng)
-    agent = sim.spawn_agent(start.x, start.y, start.yaw)
+    cells = np.argwhere(starts if starts.any() else nav_truth.cells == FREE)
+    if len(cells) == 0:
+        raise CapNavError(f"apartment seed {cfg.seed} has no free cell to start from")
+    sx, sy = nav_truth.spec.to_world(cells[int(rng.integers(len(cells)))])
+    start_yaw = float(rng.uniform(-np.pi, np.pi))
+    agent = sim.spawn_agent(float(sx), float(sy), start_yaw)
     n = len(cfg.instructions) or len(cfg.kinds)
 
     con.print(f"[bold]3/4[/] answering {n} instructions and navigating")
@@ -130,7 +134,7 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
             con.print(f"     (this apartment allows no {cfg.kinds[k]!r} instruction; skipped)")
             continue
         text, kind, targets = nxt
-        it = _answer(len(items) + 1, text, kind, targets, retriever, agent, cmap, assets, truth, pcfg_plan, out)
+        it = _answer(len(items) + 1, text, kind, targets, retriever, agent, cmap, assets, footprints, pcfg_plan, out)
         items.append(it)
         con.print(f"     {len(items)}. \\[{kind}] {escape(repr(shorten(text)))}: {it.chosen_label or '-'}: "
                   f"{escape(verdict(it))}")
@@ -160,7 +164,8 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
 
 
 def _answer(k: int, text: str, kind: str, targets: list[int], retriever: Retriever, agent: Any, cmap: Any,
-            assets: SimScene, truth: SceneTruth, plan_cfg: PlannerConfig, out: Path) -> ReportItem:
+            assets: SimScene, footprints: dict[int, NDArray[np.float64]], plan_cfg: PlannerConfig,
+            out: Path) -> ReportItem:
     try:
         res = run_instruction(cmap, assets.sim, retriever, text, agent=agent, config=plan_cfg,
                               out_dir=out / "images", stem=f"{k:02d}_nav")
@@ -175,10 +180,9 @@ def _answer(k: int, text: str, kind: str, targets: list[int], retriever: Retriev
     if kind == "absent":
         item.correct = not q.found
     elif targets:  # right only when the agent stops within reach of an instance the instruction meant
-        fps = [truth.footprints[t] for t in targets]
+        fps = [footprints[t] for t in targets]
         if obj is not None:  # the chosen object is right when the nearest true instance to it is meant
-            near = min(truth.footprints, key=lambda i: distance_to_instances(
-                obj.position[:2], [truth.footprints[i]]))
+            near = min(footprints, key=lambda i: distance_to_instances(obj.position[:2], [footprints[i]]))
             item.right_object = near in targets
         if nav is not None:
             item.truth_distance = distance_to_instances(nav.final_pose[:2], fps)

@@ -68,7 +68,7 @@ def _record(scene: int, cfg: ChangeTrackConfig, folder: Path) -> tuple[Path, Pat
 
 
 def _episodes(scene: int, cfg: ChangeTrackConfig, m1: Any, m2: Any, truth: SceneTruth) -> dict[str, list[Episode]]:
-    from capnav.eval.instructions import InstructionGenerator
+    from capnav.sim.instructions import InstructionGenerator
 
     rng = np.random.default_rng([cfg.seed, scene, 0xC4A6])
     gen1, gen2 = InstructionGenerator(m1), InstructionGenerator(m2)

@@ -18,7 +18,7 @@ from capnav.eval.episodes import Episode
 from capnav.eval.generate import SceneTruth
 from capnav.eval.method import NavMethod, SceneContext, SubgoalOutcome
 from capnav.eval.metrics import SubgoalRecord
-from capnav.eval.success import distance_to_instances
+from capnav.sim.success import distance_to_instances
 
 #: A chosen target counts as the right instance when it lies this close to the instance's footprint
 #: (map centroids of large objects sit inside their footprint; small ones within a few decimetres).

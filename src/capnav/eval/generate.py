@@ -4,7 +4,7 @@ Start poses are random navigable cells; subgoals are drawn from the categories p
 protocol) or from instances that have lookalikes of their category (description protocol), and
 must be reachable. The first goal must not already be reached at the start, so no subgoal is won
 by standing still. Only the episode *content* is seeded here; the texts of description goals come
-from the instruction generator (``capnav.eval.instructions``) through a ``Describe`` callable.
+from the instruction generator (``capnav.sim.instructions``) through a ``Describe`` callable.
 """
 
 from __future__ import annotations
@@ -20,8 +20,8 @@ from capnav.core.footprint import footprint_distance
 from capnav.core.grid import GridSpec
 from capnav.eval.episodes import Episode, StartPose, Subgoal
 from capnav.eval.geodesic import DistanceField, distance_field
-from capnav.eval.success import SUCCESS_RADIUS_M
 from capnav.sim.sightline import SightGrid
+from capnav.sim.success import SUCCESS_RADIUS_M
 
 
 @dataclass(frozen=True)
@@ -37,21 +37,6 @@ class EpisodeConfig:
     def __post_init__(self) -> None:
         if self.episodes_per_scene < 1 or self.subgoals < 1:
             raise InputError(f"need >= 1 episode and subgoal, got {self.episodes_per_scene}, {self.subgoals}")
-
-
-def start_cells(clearance: NDArray[np.floating], inside: NDArray[np.bool_], margin: float) -> NDArray[np.bool_]:
-    """Where an episode may start: cells whose clearance to every true obstacle exceeds ``margin``
-    (the planner's inflation and a map cell: the start is free on the robot's own costmap, not
-    only on the true grid), in the largest region connected through such cells (so the way out of
-    the start has the margin too, not just the robot's radius)."""
-    from scipy import ndimage
-
-    fits = np.asarray(inside, dtype=bool) & (np.asarray(clearance) > margin)
-    labels, n = ndimage.label(fits, structure=np.ones((3, 3), dtype=bool))
-    if n == 0:
-        return fits
-    sizes = ndimage.sum_labels(np.ones_like(labels), labels, index=np.arange(1, n + 1))
-    return np.asarray(labels == int(np.argmax(sizes)) + 1)
 
 
 @dataclass

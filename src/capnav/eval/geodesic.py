@@ -19,7 +19,7 @@ from scipy.sparse.csgraph import dijkstra
 from capnav.core.errors import InputError
 from capnav.core.footprint import footprint_distance
 from capnav.core.grid import GridSpec
-from capnav.eval.success import SUCCESS_RADIUS_M
+from capnav.sim.success import SUCCESS_RADIUS_M
 
 
 @dataclass

@@ -9,10 +9,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from capnav.core.grid import FREE
-from capnav.eval.generate import SceneTruth, start_cells
+from capnav.eval.generate import SceneTruth
 from capnav.language.embedder import TextEmbedder
 from capnav.pipeline.simulated import MAP_FILE, FrameList, PipelineConfig, SimScene, build_scene_map, open_sim_scene
 from capnav.planning.config import PlannerConfig
+from capnav.sim.navgrid import start_cells
 from capnav.sim.sightline import sight_grid
 
 __all__ = ["MAP_FILE", "FrameList", "PipelineConfig", "SceneAssets", "build_scene_map", "open_scene"]

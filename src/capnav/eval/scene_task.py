@@ -84,7 +84,7 @@ def generate_scene_episodes(assets: SceneAssets, config: EvalConfig, protocol: s
     rng = np.random.default_rng([config.seed, assets.scene_seed, PROTOCOLS.index(protocol)])
     if protocol == "label":
         return label_episodes(assets.truth, rng, config.episode_config())
-    from capnav.eval.instructions import InstructionGenerator
+    from capnav.sim.instructions import InstructionGenerator
 
     describe = InstructionGenerator(assets.sim.manifest).describe
     return description_episodes(assets.truth, describe, rng, config.episode_config())

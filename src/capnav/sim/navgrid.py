@@ -129,3 +129,16 @@ class NavGrid:
 
     def free_points(self) -> NDArray[np.float64]:
         return self.spec.to_world(self._cells)
+
+
+def start_cells(clearance: NDArray[np.floating], inside: NDArray[np.bool_], margin: float) -> NDArray[np.bool_]:
+    """Where an episode may start: cells whose clearance to every true obstacle exceeds ``margin``
+    (the planner's inflation and a map cell: the start is free on the robot's own costmap, not
+    only on the true grid), in the largest region connected through such cells (so the way out of
+    the start has the margin too, not just the robot's radius)."""
+    fits = np.asarray(inside, dtype=bool) & (np.asarray(clearance) > margin)
+    labels, n = ndimage.label(fits, structure=np.ones((3, 3), dtype=bool))
+    if n == 0:
+        return fits
+    sizes = ndimage.sum_labels(np.ones_like(labels), labels, index=np.arange(1, n + 1))
+    return np.asarray(labels == int(np.argmax(sizes)) + 1)

@@ -4,12 +4,12 @@ import numpy as np
 import pytest
 
 from capnav.core.categories import NAMES
+from capnav.core.colour import ciede2000, srgb_to_lab
 from capnav.core.errors import InputError
-from capnav.eval.instructions import KINDS, InstructionGenerator, generate_instructions
-from capnav.language.colors import ciede2000, srgb_to_lab
 from capnav.retrieval import parse_instruction
 from capnav.sim.apartment import generate_apartment
 from capnav.sim.config import SimConfig
+from capnav.sim.instructions import KINDS, InstructionGenerator, generate_instructions
 
 
 @pytest.fixture(scope="module")

@@ -1,6 +1,7 @@
 """Seeded natural-language instructions with ground-truth targets, from a scene manifest.
 
-Evaluation only (it reads the manifest). Kinds:
+From the simulator's truth (it reads the manifest): the benchmark's description goals and the demo's
+instructions. Kinds:
   ``attribute``   category + colour that singles one instance out among lookalikes
   ``superlative`` the biggest / smallest instance of a category
   ``relation``    the X next to the Y (unique: no other X is near a Y)
@@ -26,9 +27,9 @@ from typing import Any
 import numpy as np
 
 from capnav.core.categories import BY_NAME, NAMES
+from capnav.core.colour import ciede2000, srgb_to_lab
 from capnav.core.errors import InputError
 from capnav.core.footprint import footprint_distance
-from capnav.language.colors import ciede2000, srgb_to_lab
 from capnav.sim.manifest import ObjectInstance, SceneManifest
 
 KINDS: tuple[str, ...] = ("attribute", "superlative", "relation", "room", "category", "closest", "absent")
