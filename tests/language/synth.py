@@ -191,3 +191,18 @@ def plant_points(center: tuple[float, float], foliage_radius: float, seed: int =
     leaves = disc_points(center, foliage_radius, 0.8, 1500, seed + 1)
     leaves[:, 2] += 0.3
     return np.concatenate([pot, leaves])[rng.permutation(2100)].astype(np.float32)
+
+
+def grid_with_walls(xmin: float, ymin: float, xmax: float, ymax: float,
+                    walls: list[tuple[float, tuple[float, float]]]) -> OccupancyGrid:
+    """A FREE rectangle with outer walls and a wall at each x of ``walls``, each with a door (y range)."""
+    spec = GridSpec.covering(xmin, ymin, xmax, ymax, 0.05, margin=0.2)
+    cells = np.full((spec.rows, spec.cols), FREE, dtype=np.uint8)
+    cells[:3, :], cells[-3:, :], cells[:, :3], cells[:, -3:] = OCCUPIED, OCCUPIED, OCCUPIED, OCCUPIED
+    for wall_x, (d0, d1) in walls:
+        col = int(spec.to_cell(np.array([wall_x, 0.0]))[1])
+        cells[:, col - 1:col + 2] = OCCUPIED
+        r0 = int(spec.to_cell(np.array([0.0, d0]))[0])
+        r1 = int(spec.to_cell(np.array([0.0, d1]))[0])
+        cells[r0:r1, col - 1:col + 2] = FREE
+    return OccupancyGrid(spec, cells)

@@ -255,6 +255,8 @@ class OfflineVerifier(Verifier):
         if alt is not None:
             want = q.category or q.purpose or q.target_phrase
             return True, alt[0], f"{a(alt[1])} can serve as {a(want)} (weight {alt[0]:.2f})"
+        if q.generic and q.category is None and not q.category_alternatives:
+            return True, 1.0, f"it is {a(name)} (any object was asked for)"
         noun = q.category or (" ".join(q.unknown_words) if q.unknown_words else q.target_phrase)
         if q.category is None and q.category_alternatives:
             return False, 0.0, f"it is {a(name)}, not one of {', '.join(sorted(q.category_alternatives))}"

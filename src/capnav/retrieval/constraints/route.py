@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from capnav.language.context import HALLWAY
 from capnav.retrieval.constraints.base import SUPPORTED, UNOBSERVED, Evidence, RankingConstraint, RankState, ranking
 from capnav.retrieval.query import ParsedQuery
 
@@ -81,7 +82,9 @@ class Route(RankingConstraint):
         if _CACHE not in cache:
             cache[_CACHE] = region_labels(scene)
         labels = cache[_CACHE]
-        origin = {k for k, (room, _) in scene.region_rooms.items() if room == q.origin_room}
+        # A hallway has no objects of its own to type it by: the regions no room type was inferred for.
+        typed = None if q.origin_room == HALLWAY else q.origin_room
+        origin = {k for k, (room, _) in scene.region_rooms.items() if room == typed}
         if labels is None or not origin:
             st.notes.append(f"no region of the map is typed {q.origin_room}, so the way in from it is not known; "
                             "the route was not used")

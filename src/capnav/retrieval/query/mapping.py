@@ -15,8 +15,9 @@ from capnav.core.categories import BY_NAME
 from capnav.language.colors import ALIASES, LEXICON
 from capnav.language.context import ROOM_SYNONYMS
 from capnav.language.purpose import find_activity, match_purpose, purpose_categories
+from capnav.retrieval.query.count import read_count, without
 from capnav.retrieval.query.model import BETWEEN, ROOM_WITH, ParsedQuery
-from capnav.retrieval.query.parse import GoalParse, describe
+from capnav.retrieval.query.parse import _GENERIC, GoalParse, describe
 from capnav.retrieval.query.tokens import (
     _COMMON_ADJECTIVES,
     _FILLER,
@@ -210,6 +211,32 @@ def _negations(q: ParsedQuery, head: str) -> str:
     return " ".join(out.split())
 
 
+_FROM_ROBOT = "the robot"
+
+
+def _count(q: ParsedQuery, head: str) -> str:
+    """Fill the ordinal and where it counts from (``count.read_count``); returns ``head`` without
+    the words that said them, so that a landmark the count starts at is never the target."""
+    c = read_count(head)
+    if c.ordinal is None and c.origin_room is None:
+        return head
+    q.ordinal = c.ordinal
+    if c.origin_room is not None:
+        q.origin_room = c.origin_room
+        q.ordinal_from = f"the way in from the {c.origin_room}" if c.ordinal else None
+        if c.door_owner is not None and c.door_owner != c.origin_room:
+            q.room = c.door_owner  # "the office's hall door": the count is in the office
+    elif c.landmark_category is not None:
+        q.anchor_category, q.anchor_phrase = c.landmark_category, c.landmark_phrase
+        q.proximity, q.proximity_to_anchor = "closest", True
+        q.ordinal_from = c.landmark_phrase
+    elif c.skipped_nearest:
+        # "skip the nearest chair and take the next": the second closest (to the robot, unless
+        # the route's origin comes from the parse: ``goal_query``)
+        q.proximity, q.ordinal_from = "closest", _FROM_ROBOT
+    return without(head, c.spans)
+
+
 def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     """Read ``text``. With ``embedder`` (the retriever's), a request by purpose ("somewhere to
     sit") is mapped to categories through the lexicon's glosses; without one it keeps ``purpose``
@@ -225,6 +252,9 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     head = _purpose_context(q, head)
     # "the bed in the room with the pink dresser", "the wardrobe in the bedroom with the yellow bed".
     head = _room_with(q, head)
+    # An ordinal and where it counts from: "the second stool from the fridge", "number two from
+    # the hall door", "skip the nearest sofa and take the next one".
+    head = _count(q, head)
     # Room: "in the kitchen", "in the living room".
     for phrase in sorted(ROOM_SYNONYMS, key=len, reverse=True):
         if phrase not in head:  # cheap test first: a one-shot query compiles only the patterns it needs
@@ -332,6 +362,8 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                     q.category, q.category_alternatives, q.unknown_words = best, alts, []
     else:
         q.unknown_words = rest
+    if q.category is None and q.purpose is None and any(w in _GENERIC for w in words):
+        q.generic, q.unknown_words = True, []
     desc = list(dict.fromkeys(w for part in (*q.colors, *q.materials, *q.shapes) for w in part.split()))
     noun = q.category if q.category is not None else " ".join(rest[-2:]) if rest else ""
     q.target_phrase = " ".join([*desc, noun]).strip() or norm
@@ -347,13 +379,21 @@ def goal_query(g: GoalParse, embedder: TextEmbedder | None = None) -> ParsedQuer
     if not g.dropped:
         q.text = validate_instruction(g.text)
     q.parser, q.notes, q.dropped_words = g.parser, [*g.notes, *q.notes], list(g.dropped)
-    q.origin_room = g.origin_room
+    q.origin_room = g.origin_room or q.origin_room
     q.side = g.side
     q.structure = describe(g)
     if q.ordinal is None:
         # "the second bookshelf from the door", "the first desk you reach": an ordinal on the head,
         # counted in the order a route or a predicate gives.
         q.ordinal = next((_ORDINALS[m.lower()] for m in g.modifiers if m.lower() in _ORDINALS), None)
+    if q.generic and not (q.has_attributes or q.ordinal or q.origin_room or q.side):
+        q.generic = False  # "the thing" alone says nothing that could pick one object
+    if q.room is None:
+        # "walking down the hallway from the bedroom door": a room walked along is where the
+        # target stands when the route names no room it goes into.
+        q.room = next((r for role, r in g.rooms if role == "along" and r != q.origin_room), None)
+    if q.origin_room is not None and q.ordinal_from == _FROM_ROBOT:
+        q.proximity, q.ordinal_from = None, f"the way in from the {q.origin_room}"  # skipped from the door
     if q.origin_room is not None and q.room == q.origin_room:
         q.room = next((r for role, r in g.rooms if role == "target" and r != q.origin_room), None)
     return q

@@ -48,6 +48,9 @@ class ParsedQuery:
     #: What an ordinal counts from or along ("the second bookshelf from the door"): a phrase.
     ordinal_from: str | None = None
     structure: dict[str, object] = field(default_factory=dict)  # the parse of the goal (head, modifiers, ...)
+    #: The target was named by a word for any object ("the third thing you reach", "the one by the
+    #: door") with a predicate that picks it: every category may answer.
+    generic: bool = False
 
     @property
     def has_attributes(self) -> bool:

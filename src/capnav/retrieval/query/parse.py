@@ -54,8 +54,15 @@ _GOAL_PREPS = {"to", "towards", "toward", "into", "onto", "on", "at", "over", "i
 #: Where a room stands in a route: the target's own room, where one comes from, what one passes.
 _ROOM_ORIGIN = {"from", "out", "leaving", "leave", "exit", "exiting", "door"}
 _DOORS = {"door", "doorway", "entrance", "entry", "archway", "opening", "doors"}
-_ROOM_PASSED = {"through", "past", "via", "across", "along"}
+_DOOR_PREPS = {"to", "into", "of", "from", "for", "onto"}
+_ROOM_PASSED = {"through", "past", "via", "across"}
 _ROOM_DEST = {"into", "to", "towards", "toward", "entering", "enter", "onto"}
+#: A room one walks along ("down the hallway", "along the corridor"): where the target stands
+#: unless the route also names a room it goes into.
+_ROOM_ALONG = {"along", "down", "up"}
+#: Verbs that start a count or a route at an object ("start at the TV", "beginning by the fridge"):
+#: their object is where one starts, a landmark, not the goal.
+_START_VERBS = {"start", "begin", "count"}
 _NEGATIVE = {"not", "n't", "except", "other", "than", "but", "without", "nor"}
 _SIDES = {"left": "left", "right": "right", "left-hand": "left", "right-hand": "right", "lefthand": "left",
           "righthand": "right"}
@@ -159,6 +166,9 @@ def split_goals(text: str) -> list[str]:
         p = p.strip(" ,")
         if not p:
             continue
+        if out and not pending and not seq and _points_back(p):
+            out[-1] = f"{out[-1]} {p}"  # "Which lamp is second from the door? Go there.": the same goal
+            continue
         p = f"{pending} {p}".strip() if pending else p
         if _names_goal(p, seq):
             out.append(p)
@@ -178,6 +188,18 @@ def _names_goal(piece: str, after_sequence_word: bool) -> bool:
     cat, _, _ = _find_category(words)
     return cat is not None or find_activity(piece.lower()) is not None or bool(_GENERIC.intersection(words)) \
         or (after_sequence_word and _unknown_object(words))
+
+
+#: Words that point back at an object already named ("go there", "take me to it", "that one").
+_POINTERS = {"there", "it", "that", "this", "them", "those"}
+
+
+def _points_back(piece: str) -> bool:
+    """A sentence that names no object or use of its own and points back at one ("Go there.",
+    "That is the one I want."): it belongs to the goal before it."""
+    words = re.findall(r"[a-z][a-z\-']*", piece.lower())
+    cat, _, _ = _find_category(words)
+    return cat is None and find_activity(piece.lower()) is None and bool(_POINTERS.intersection(words))
 
 
 def _unknown_object(words: list[str]) -> bool:
@@ -256,6 +278,8 @@ def _depth(t: Token) -> int:
 def _is_landmark(t: Token) -> bool:
     """Whether the noun ``t`` is the object of a landmark preposition ("next to the fridge") or
     the subject of a clause about another object ("the desk the chair is pulled up to")."""
+    if t.dep_ == "pobj" and t.head.head.lemma_.lower() in _START_VERBS:
+        return True
     if t.dep_ == "pobj" and t.head.text.lower() in _LANDMARK_PREPS:
         p = t.head
         on_verb = p.head.pos_ in ("VERB", "AUX") or p.head.i == p.i or (p.head.dep_ == "ROOT" and p.head.pos_ != "NOUN")
@@ -270,13 +294,20 @@ def _governor(t: Token) -> str:
     h = t.head
     if (t.dep_ == "pobj" and h.head.lower_ in _DOORS) or (t.dep_ == "compound" and h.lower_ in _DOORS):
         return "door"  # "the door to the hall", "the hall door": the room on the door's other side
+    if t.i + 1 < len(t.doc) and t.doc[t.i + 1].lower_ in _DOORS:
+        return "door"  # "the bathroom door" however the parser attached the two nouns
+    if t.dep_ == "pobj" and h.i > 0 and h.lower_ in _DOOR_PREPS and t.doc[h.i - 1].lower_ in _DOORS:
+        # "the second sink from the door to the lounge" with "to the lounge" hung on the sink by
+        # the parser: a room right after "door to" is still the door's other side.
+        return "door"
     if t.dep_ == "pobj":
         w = h.text.lower()
         if w == "of" and h.head.text.lower() == "out":
             return "out"
         return w
     if t.dep_ in ("dobj", "npadvmod") and h.pos_ == "VERB":
-        return h.lemma_.lower() or h.text.lower()
+        prt = next((c.lower_ for c in h.children if c.dep_ == "prt" and c.lower_ in _ROOM_ALONG), None)
+        return prt or h.lemma_.lower() or h.text.lower()  # "walking down the hallway": along it
     if t.dep_ == "compound":
         return "compound"
     return t.dep_
@@ -300,7 +331,8 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
             g.side = _SIDES[t.text.lower()]
     for s, e, room in rooms:
         gov = _governor(_span_head(doc, s, e))
-        role = "origin" if gov in _ROOM_ORIGIN else "passed" if gov in _ROOM_PASSED else "target"
+        role = "origin" if gov in _ROOM_ORIGIN else "passed" if gov in _ROOM_PASSED else \
+            "along" if gov in _ROOM_ALONG else "target"
         g.rooms.append((role, room))
         if role == "origin" and g.origin_room is None:
             g.origin_room = room
@@ -339,6 +371,8 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
     for s2, e2, _room in rooms:
         rh = _span_head(doc, s2, e2)
         gov = _governor(rh)
+        if gov == "door":
+            continue  # "from the door to the hall": the mapping reads the door phrase whole (count.py)
         if gov in _ROOM_ORIGIN or gov in _ROOM_PASSED:
             prep = rh.head if rh.dep_ == "pobj" else rh
             drop = {t.i for t in prep.subtree}
@@ -421,7 +455,7 @@ def _words(doc: Doc, keep: set[int], rooms: list[tuple[int, int, str]]) -> str:
     dest = set()
     for s, e, _ in rooms:
         rh = _span_head(doc, s, e)
-        if rh.dep_ == "pobj" and rh.head.text.lower() in _ROOM_DEST:
+        if rh.dep_ == "pobj" and rh.head.text.lower() in _ROOM_DEST and _governor(rh) != "door":
             dest.add(rh.head.i)
     for t in doc:
         if t.i not in keep:
