@@ -89,7 +89,7 @@ def test_a_phrasing_run_shows_only_its_own_table_without_chains() -> None:
     md = render(sums, {"seed": 0, "scenes": 1, "scene_seeds": [61], "episodes_per_scene": 9,
                        "instructions": "dev.jsonl"})
     assert "## Table 1" not in md and "## Table 2" not in md and "## Description protocol" not in md
-    assert "| Method | Success | SPL | Strict success |" in md
+    assert "| Method | Success [95% CI] | SPL | Strict success | Strict, in its room |" in md
     assert "episodes from `dev.jsonl`" in md and "episodes per apartment" not in md
     assert next(ln for ln in md.splitlines() if ln.startswith("| capnav |")).startswith("| capnav | 90.0 | 50.0 |")
 
@@ -100,3 +100,20 @@ def test_the_console_line_of_a_phrasing_run_has_no_chains() -> None:
     assert "in a row" not in summary_line(summ("capnav", "phrasing", [0.9, 0.0, 0.0, 0.0], 0.9))
     assert "in a row 100 / 50 / 50 / 25, indep. 62.5%" in summary_line(summ("capnav", "label",
                                                                             [1.0, 0.5, 0.5, 0.25], 0.625))
+
+
+def test_the_interval_and_the_room_rule_stand_beside_independent_success() -> None:
+    """A reader sees the spread (bootstrap interval) and the strict rule with the room next to the
+    paper's figure; a run without room truth says "–" rather than 0."""
+    with_room = summ("capnav", "description", [0.5, 0.5, 0.0, 0.0], 0.5)
+    with_room.independent_ci = [0.25, 0.75]
+    with_room.independent_strict, with_room.independent_room = 0.5, 0.375
+    no_room = summ("vlmaps", "description", [0.5, 0.0, 0.0, 0.0], 0.4)
+    md = render([with_room, no_room], {"seed": 0, "scenes": 1, "scene_seeds": [0], "episodes_per_scene": 2})
+    rows: dict[str, str] = {}
+    for ln in md.splitlines():  # the first row of each method: the description table, before the details
+        if ln.startswith(("| capnav |", "| vlmaps |")):
+            rows.setdefault(ln.split(" | ")[0], ln)
+    assert "| 50.0 [25.0-75.0] |" in rows["| capnav"] and rows["| capnav"].endswith("| 50.0 | 37.5 |")
+    assert rows["| vlmaps"].endswith("| – | – |") and "| 40.0 |" in rows["| vlmaps"]
+    assert "Strict, in its room" in md

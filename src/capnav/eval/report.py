@@ -30,6 +30,14 @@ def pct(x: float | None) -> str:
     return "–" if x is None else f"{100.0 * x:.1f}"
 
 
+def _with_ci(s: Summary) -> str:
+    """Independent success with its bootstrap 95% interval over episodes, when there is one."""
+    if not s.independent_ci:
+        return pct(s.independent)
+    lo, hi = s.independent_ci
+    return f"{pct(s.independent)} [{pct(lo)}-{pct(hi)}]"
+
+
 def _sorted(summaries: Sequence[Summary]) -> list[Summary]:
     rank = {m: i for i, m in enumerate(ORDER)}
     return sorted(summaries, key=lambda s: (rank.get(_key(s.method), len(ORDER)), s.method))
@@ -39,25 +47,27 @@ def table1(summaries: Sequence[Summary], protocol: str = "label") -> list[str]:
     """In-a-row success for 1..4 subgoals and independent success, under the paper's rule and the
     strict one; the paper's numbers beside ours only for its own (label-only) protocol."""
     paper_cols = protocol == "label"
-    lines = ["| Method | 1 | 2 | 3 | 4 | Indep. | SPL | Strict 1 / 2 / 3 / 4 | Strict indep. "
-             + ("| Paper 1 / 2 / 3 / 4 | Paper indep. |" if paper_cols else "|"),
-             "|---|---:|---:|---:|---:|---:|---:|---|---:|" + ("---|---:|" if paper_cols else "")]
+    lines = ["| Method | 1 | 2 | 3 | 4 | Indep. [95% CI] | SPL | Strict 1 / 2 / 3 / 4 | Strict indep. "
+             "| Strict, in its room " + ("| Paper 1 / 2 / 3 / 4 | Paper indep. |" if paper_cols else "|"),
+             "|---|---:|---:|---:|---:|---:|---:|---|---:|---:|" + ("---|---:|" if paper_cols else "")]
     for s in _sorted([s for s in summaries if s.protocol == protocol]):
         p = paper_row(s.method)
         paper = " / ".join(f"{v:g}" for v in p.in_a_row) if p else "–"
         paper_ind = f"{p.independent:g}" if p else "–"
         row = " | ".join(pct(v) for v in s.in_a_row)
         strict = " / ".join(pct(v) for v in s.in_a_row_strict) if s.in_a_row_strict else "–"
-        lines.append(f"| {s.method} | {row} | {pct(s.independent)} | {pct(s.spl)} | {strict} "
-                     f"| {pct(s.independent_strict)} |" + (f" {paper} | {paper_ind} |" if paper_cols else ""))
+        lines.append(f"| {s.method} | {row} | {_with_ci(s)} | {pct(s.spl)} | {strict} "
+                     f"| {pct(s.independent_strict)} | {pct(s.independent_room)} |"
+                     + (f" {paper} | {paper_ind} |" if paper_cols else ""))
     return lines
 
 
 def _single(summaries: Sequence[Summary], protocol: str) -> list[str]:
     """Success, SPL and strict success of one-subgoal episodes (the free-phrasing protocol)."""
-    lines = ["| Method | Success | SPL | Strict success |", "|---|---:|---:|---:|"]
+    lines = ["| Method | Success [95% CI] | SPL | Strict success | Strict, in its room |", "|---|---:|---:|---:|---:|"]
     for s in _sorted([s for s in summaries if s.protocol == protocol]):
-        lines.append(f"| {s.method} | {pct(s.independent)} | {pct(s.spl)} | {pct(s.independent_strict)} |")
+        lines.append(f"| {s.method} | {_with_ci(s)} | {pct(s.spl)} | {pct(s.independent_strict)} "
+                     f"| {pct(s.independent_room)} |")
     return lines
 
 
@@ -176,7 +186,9 @@ def render(summaries: Sequence[Summary], config: Mapping[str, Any],
                "absolute numbers are not comparable across the two setups.")
     out += ["", "Success is the paper's rule (the agent stops within 1 m of a goal instance's footprint); "
             "*strict* also asks that it sees the object: a straight line from the stop point to the "
-            "footprint that no wall and no object 1 m or taller crosses (`capnav.sim.sightline`).", ""]
+            "footprint that no wall and no object 1 m or taller crosses (`capnav.sim.sightline`); *strict, in its "
+            "room* also asks that the stop point is in the room the object stands in. The interval beside "
+            "independent success is a bootstrap 95% interval over episodes.", ""]
     protocols = {s.protocol for s in summaries}  # a table only for the protocols this run measured
     if "label" in protocols:
         out += ["", "## Table 1: multi-object navigation, label-only protocol (success %, in a row)", ""]
