@@ -104,3 +104,21 @@ def test_a_bowl_stands_on_a_desk_but_an_armrest_does_not_stand_on_its_chair() ->
     chair = np.c_[g * 0.5, np.full(len(g), 0.45)]
     armrest = chair[chair[:, 0] < 0.05] + [0.0, 0.0, 0.005]
     assert not stands_on(armrest, chair)
+
+
+def test_a_plane_one_height_bin_thick_is_found_without_empty_bins() -> None:
+    """Up-facing points all within one height bin (a histogram shorter than the peak window) give
+    that plane for the thing above it, with no peak placed on an empty bin (no empty-median NaN)."""
+    import warnings
+
+    from capnav.mapping.support import SupportCutConfig, support_plane
+
+    cfg = SupportCutConfig()
+    plane = np.full(400, 0.75)
+    thing = np.linspace(0.80, 0.95, 40)
+    z = np.concatenate([plane, thing])
+    up = np.concatenate([np.ones(400, bool), np.zeros(40, bool)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for highest in (True, False):
+            assert support_plane(z, up, cfg, highest=highest) == 0.75

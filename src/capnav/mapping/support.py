@@ -90,7 +90,9 @@ def support_plane(z: NDArray[np.float64], up: NDArray[np.bool_], cfg: SupportCut
     lo = float(zu.min())
     idx = ((zu - lo) / cfg.bin).astype(np.int64)
     counts = np.bincount(idx)
-    win = np.convolve(counts, np.ones(3), mode="same")  # mass within one bin either side
+    win = counts.astype(np.float64)  # mass within one bin either side (np.convolve's "same" pads a
+    win[1:] += counts[:-1]  # histogram shorter than the kernel to the kernel's length: empty bins)
+    win[:-1] += counts[1:]
     peaks = [k for k in range(len(win)) if win[k] >= need and win[k] >= win[max(k - 1, 0)]
              and win[k] >= win[min(k + 1, len(win) - 1)]]
     for k in sorted(peaks, reverse=highest):
