@@ -11,7 +11,7 @@ from capnav.sim.config import CameraConfig, LayoutConfig, SimConfig
 
 
 def test_episodes_per_change_class() -> None:
-    cfg = ChangeTrackConfig(scenes=1, changes=ChangeSpec(moved=2, removed=1, added=1), per_class=3)
+    cfg = ChangeTrackConfig(scenes=1, changes=ChangeSpec(moved=2, removed=1, added=1), per_class=8)
     sc = SimConfig(layout=LayoutConfig(rooms=3), camera=CameraConfig(width=64, height=48))
     with Simulator.from_seed(2, sc) as s1, Simulator.from_seed(2, sc, visit=2, changes=cfg.changes) as s2:
         nav = s2.navigable()
@@ -19,10 +19,13 @@ def test_episodes_per_change_class() -> None:
         eps = _episodes(2, cfg, s1.manifest, s2.manifest, truth)
         kinds = {c.id: c.kind for c in s2.manifest.changes}
         present = {o.id for o in s2.manifest.objects}
-    assert set(eps) == set(CLASSES) and all(len(e) == 3 for e in eps.values())
+        cats = {v: [o.category for o in s.manifest.objects] for v, s in ((1, s1), (2, s2))}
+    assert set(eps) == set(CLASSES) and all(len(e) == 8 for e in eps.values())
     for cls, episodes in eps.items():
         for ep in episodes:
             (g,) = ep.subgoals
+            if g.kind == "category":  # a bare kind only when it names one object of the home described
+                assert cats[1 if cls == "removed" else 2].count(g.category) == 1, (cls, g.text)
             if cls == "removed":  # described as at visit 1; the right answer is "not found"
                 assert g.absent
             else:

@@ -9,7 +9,8 @@ then three maps answer the same one-subgoal episodes in the visit-2 world:
 
 Goals are written from the truth the user holds, per change class (protocol ``description/<class>``):
 ``moved`` (described as at visit 2; success = reached at its new place), ``removed`` (described as at
-visit 1; success = "not found"), ``added`` and ``unchanged`` (success = reached). Only the harness
+visit 1; success = "not found"), ``added`` and ``unchanged`` (success = reached). Each description
+names its object alone in the home it describes (never a bare kind shared by several). Only the harness
 reads the manifests; the maps see frames. The update's CPU time (detection included) is measured
 beside mapping visit 2 from scratch on the same frames.
 """
@@ -81,18 +82,39 @@ def _episodes(scene: int, cfg: ChangeTrackConfig, m1: Any, m2: Any, truth: Scene
     for cls, pool in pools.items():
         eps: list[Episode] = []
         if cls == "unchanged":
-            pool = [pool[int(i)] for i in rng.permutation(len(pool))[: cfg.per_class]]
-        for n in range(cfg.per_class if pool else 0):
-            i = pool[n % len(pool)]
+            pool = [pool[int(i)] for i in rng.permutation(len(pool))]
+        man = m1 if cls == "removed" else m2
+        gen = gen1 if cls == "removed" else gen2
+        tried = 0
+        while pool and len(eps) < cfg.per_class and tried < 4 * cfg.per_class:
+            i = pool[tried % len(pool)]
+            tried += 1
             start = truth.sample_start(rng)
-            gen = gen1 if cls == "removed" else gen2
-            text, kind = gen.describe(i, None if cls == "removed" else (start.x, start.y), rng)
-            cat = next(o.category for o in (m1 if cls == "removed" else m2).objects if o.id == i)
-            eps.append(Episode(id=f"s{scene}-{cls}-{n}", scene_seed=scene, start=start,
+            said = _single_out(gen, man, i, None if cls == "removed" else (start.x, start.y), rng)
+            if said is None:
+                continue
+            text, kind = said
+            cat = next(o.category for o in man.objects if o.id == i)
+            eps.append(Episode(id=f"s{scene}-{cls}-{len(eps)}", scene_seed=scene, start=start,
                                subgoals=[Subgoal(text=text, category=cat, kind=kind,
                                                  target_ids=[] if cls == "removed" else [i])]))
         out[cls] = eps
     return out
+
+
+def _single_out(gen: Any, man: Any, i: int, start_xy: tuple[float, float] | None, rng: np.random.Generator,
+                tries: int = 8) -> tuple[str, str] | None:
+    """A description of object ``i`` that names it alone in ``man``'s home: the generator falls back
+    to the bare kind ("the chair") when nothing else singles an object out, and with other chairs
+    about that names any of them, which scores nothing about the change (a removed chair's "the
+    chair" is rightly answered by a remaining one). None when no draw singles it out."""
+    cat = next(o.category for o in man.objects if o.id == i)
+    unique = sum(o.category == cat for o in man.objects) == 1
+    for _ in range(tries):
+        text, kind = gen.describe(i, start_xy, rng)
+        if kind != "category" or unique:
+            return text, kind
+    return None
 
 
 def run_change_scene(scene: int, cfg: ChangeTrackConfig, out: Path, progress: bool = False) -> dict[str, Any]:

@@ -67,7 +67,8 @@ class UpdateConfig:
 
     Matching: a new object is an old one when ``same_overlap`` of its points lie within
     ``same_radius`` of that object's points (labels compatible); a moved one when its likeness
-    to an object observed empty (descriptor cosine, colour, size) is at least ``min_likeness``.
+    to an object observed empty (descriptor cosine, colour, size) is at least ``min_likeness``;
+    one assignment decides all of them, a pair at the same place counting ``place_prior`` more.
     New objects need ``min_hits`` detections to be born."""
 
     tol: float = 0.08
@@ -90,6 +91,7 @@ class UpdateConfig:
     same_overlap: float = 0.3
     same_radius: float = 0.1
     min_likeness: float = 0.55
+    place_prior: float = 0.3
     min_hits: int = 3
     register: RegisterConfig = field(default_factory=RegisterConfig)
 
@@ -260,16 +262,72 @@ def _overlap(a: MapObject, b: MapObject, radius: float) -> float:
 
 
 def likeness(a: MapObject, b: MapObject) -> float:
-    """How alike two sightings look, in [0, 1]: descriptor cosine, mean colour, size (not place)."""
+    """How alike two sightings look, in [0, 1]: descriptor cosine, mean colour, size (not place).
+
+    A weighted geometric mean, so that one cue that disagrees outright (a mustard chair and a black
+    one of the same make) vetoes however well the others agree; sizes are compared turned (the two
+    horizontal sides sorted), since a carried object is rarely set down the same way round."""
     fa, fb = np.asarray(a.feature, np.float64), np.asarray(b.feature, np.float64)
     na, nb = float(np.linalg.norm(fa)), float(np.linalg.norm(fb))
     cos = float(fa @ fb) / (na * nb) if na > 0 and nb > 0 and fa.shape == fb.shape else 0.0
     ca = np.asarray(a.colors, np.float64).mean(axis=0) if len(a.colors) else np.zeros(3)
     cb = np.asarray(b.colors, np.float64).mean(axis=0) if len(b.colors) else np.zeros(3)
     col = float(np.exp(-np.linalg.norm(ca - cb) / 60.0))
-    sa, sb = np.maximum(a.size, 0.05), np.maximum(b.size, 0.05)
+    sa, sb = (np.concatenate([np.sort(np.maximum(s[:2], 0.05)), [max(float(s[2]), 0.05)]]) for s in (a.size, b.size))
     size = float(np.exp(-np.abs(np.log(sa / sb)).sum() / 1.5))
-    return 0.3 * max(cos, 0.0) + 0.45 * col + 0.25 * size
+    return float(np.exp(0.3 * np.log(max(cos, 1e-3)) + 0.45 * np.log(max(col, 1e-3)) + 0.25 * np.log(size)))
+
+
+def _assign(new: list[MapObject], old: list[MapObject], gone: NDArray[np.bool_], cfg: UpdateConfig
+            ) -> tuple[dict[int, int], dict[int, int], list[int]]:
+    """Which old object each new sighting is: (same place: new -> old, moved: old -> new, displaced old).
+
+    One assignment over all pairs (labels compatible), maximising the summed likeness, where a pair
+    at the same place (``same_overlap`` of the new points near the old ones) adds ``place_prior``:
+    things mostly stay. A pair at different places is allowed only when the old object is free to
+    have moved (its place was observed empty, or a new sighting overlaps it: the depth that said
+    "present" may be another object standing there) and the two look alike (``min_likeness``).
+    So a white armchair pushed onto the pink one's place while the pink one was carried off is the
+    white one moved, not the pink one seen again. An old object overlapped by a sighting that the
+    assignment gave to another is displaced (gone from its place, unless seen elsewhere)."""
+    from scipy.optimize import linear_sum_assignment
+
+    nn, no = len(new), len(old)
+    if nn == 0 or no == 0:
+        return {}, {}, []
+    score = np.full((nn, no), -np.inf)
+    same = np.zeros((nn, no), bool)
+    for j, n in enumerate(new):
+        for q, o in enumerate(old):
+            if _compatible(n, o):
+                same[j, q] = _overlap(n, o, cfg.same_radius) >= cfg.same_overlap
+    free = gone | same.any(axis=0)
+    for j, n in enumerate(new):
+        for q, o in enumerate(old):
+            if not _compatible(n, o) or not (same[j, q] or free[q]):
+                continue
+            lk = likeness(n, o)
+            if same[j, q]:
+                score[j, q] = lk + cfg.place_prior
+            elif lk >= cfg.min_likeness:
+                score[j, q] = lk
+    ok = np.isfinite(score)
+    if not ok.any():
+        return {}, {}, []
+    rows, cols = linear_sum_assignment(np.where(ok, -score, 1e6))
+    claimed: dict[int, int] = {}
+    moved: dict[int, int] = {}
+    for j, q in zip(rows.tolist(), cols.tolist(), strict=True):
+        if not ok[j, q]:
+            continue
+        if same[j, q]:
+            claimed[j] = q
+        else:
+            moved[q] = j
+    taken = set(claimed.values()) | set(moved)
+    assigned = sorted({*claimed, *moved.values()})
+    displaced = [q for q in range(no) if q not in taken and bool(same[assigned, q].any())]
+    return claimed, moved, displaced
 
 
 # ---- voxels --------------------------------------------------------------------------------
@@ -347,6 +405,7 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
         K = f.K
         depth = np.ascontiguousarray(f.depth, dtype=np.float32)
         args = (Tcw, K.fx, K.fy, K.cx, K.cy, depth, cfg.near, cfg.far, cfg.tol, cfg.margin)
+        emptied = False
         if len(ev.points):
             codes = E_.classify_points(ev.points, *args)
             seen = np.bincount(ev.owner[codes == E_.SEEN], minlength=ev.n)
@@ -355,6 +414,7 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
             empty = spoke & (thr >= cfg.empty_share * (seen + thr))
             here = spoke & (seen >= cfg.present_share * (seen + thr))
             ev.empty += empty
+            emptied = bool(empty.any())
             ev.present += here
             ev.last_present[here] = i
         if len(vc) and rep.frames % cfg.carve_stride == 0:
@@ -362,7 +422,9 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
             v_seen += vcodes == E_.SEEN
             v_through += vcodes == E_.THROUGH
         rep.frames += 1
-        changed = not cfg.gate or _new_share(f, Twc, known, cfg) >= cfg.new_share
+        # A frame shows a change when it holds surface the map lacks, or sees through an old object's
+        # place: its depth is fused there too (the floor where a chair stood becomes free).
+        changed = not cfg.gate or emptied or _new_share(f, Twc, known, cfg) >= cfg.new_share
         if changed:
             while pending:
                 g = pending.popleft()
@@ -380,33 +442,15 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
     sub = mapper.finish()
     new_objs = [o for o in sub.objects if o.hits >= cfg.min_hits]
 
-    # -- identity: at an old place = that object; like one observed empty = moved; else born --
+    # -- identity: one assignment of the new sightings to the old objects (``_assign``) --
     gone = (ev.empty >= cfg.min_empty_frames) & (ev.empty >= 2 * ev.present)
     seen_again = ev.present > 0
-    claimed: dict[int, int] = {}  # new object index -> old object index (same place)
-    for j, n in enumerate(new_objs):
-        best, best_s = -1, cfg.same_overlap
-        for q, o in enumerate(old):
-            if not _compatible(n, o):
-                continue
-            s = _overlap(n, o, cfg.same_radius)
-            if s >= best_s:
-                best, best_s = q, s
-        if best >= 0:
-            claimed[j] = best
+    claimed, moved, displaced = _assign(new_objs, old, gone, cfg)
     for q in set(claimed.values()):
         gone[q] = False
         seen_again[q] = True
-    free = [j for j in range(len(new_objs)) if j not in claimed]
-    pairs = sorted(((likeness(new_objs[j], old[q]), j, q) for j in free for q in np.flatnonzero(gone).tolist()
-                    if _compatible(new_objs[j], old[q])), reverse=True)
-    moved: dict[int, int] = {}  # old index -> new index
-    for s, j, q in pairs:
-        if s < cfg.min_likeness:
-            break
-        if q in moved or j in moved.values():
-            continue
-        moved[q] = j
+    for q in displaced:  # its place holds another object now, and it was not seen elsewhere
+        gone[q] = True
 
     ts = reader.timestamps
 
@@ -474,6 +518,16 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
 
     # -- geometry: carve what was seen through, fuse what was detected, derive occupancy again --
     carve = (v_through >= cfg.carve_frames) & (v_through > v_seen)
+    # An object that left its place takes its surface with it: the voxels of its points go, unless
+    # the new recording saw them (something else stands there now). The object's evidence came
+    # from every frame; the voxels' own count only from every ``carve_stride``-th one.
+    left = [q for q, o in enumerate(old) if q in moved or gone[q]]
+    if left and len(vox):
+        own = np.concatenate([np.asarray(old[q].points, np.float64).reshape(-1, 3) for q in left])
+        own = own[own[:, 2] >= mapper.config.occupancy.floor_max]  # the floor under it stays
+        slots = vox.slots(vox.index_of(own))
+        slots = np.unique(slots[slots >= 0])
+        carve[slots[v_seen[slots] == 0]] = True
     rep.voxels_carved = int(carve.sum())
     voxels = _merge_voxels(vox, ~carve, sub.voxels)
     occ = occupancy_from_voxels(voxels, mapper.config.occupancy)

@@ -155,8 +155,9 @@ class Retriever:
                 raise InputError(f"robot position must be two finite numbers x, y, got {robot_xy!r}")
         if self._time and isinstance(instruction, str):
             answered = self._about_time(instruction, robot_xy)
-            if answered is not None:
+            if isinstance(answered, QueryResult):
                 return answered
+            instruction = answered or instruction
         q = instruction if isinstance(instruction, ParsedQuery) else parse_instruction(instruction, self.embedder)
         t0 = time.perf_counter()
         e_q = self.embedder.embed([q.text])[0]
@@ -215,12 +216,28 @@ class Retriever:
                            judged[chosen_i].terms if chosen_i in judged else {},
                            judged[chosen_i].value if chosen_i in judged else None)
 
-    def _about_time(self, instruction: str, robot_xy: tuple[float, float] | None) -> QueryResult | None:
+    def _about_time(self, instruction: str, robot_xy: tuple[float, float] | None
+                    ) -> QueryResult | ParsedQuery | None:
         """Time words narrow the objects; a best match that is retired is "not found" (when last seen).
-        None: answer from the present objects as usual."""
+        Otherwise the present objects answer (None, or the request already parsed).
+
+        Without time words the whole history is asked only when the request says more than a kind
+        (a colour, a room, a neighbour, a superlative ...) or no object of that kind is left: "the
+        writing desk" is any desk there is now, however near the robot a desk that is gone once
+        stood, while "the pink chair" is the pink one even when another chair remains. A request
+        about the robot ("the nearest chair") is about now. The history is ranked without the
+        robot's position: nearness to a place an object has left says nothing about which one was
+        meant."""
         scope = time_scope.read_time(instruction)
         if scope is None and not self.cmap.retired:
             return None
+        parsed: ParsedQuery | None = None
+        if scope is None:
+            parsed = parse_instruction(instruction, self.embedder)
+            bare = not (parsed.has_attributes or parsed.negations or parsed.ordinal)
+            if parsed.proximity is not None or (bare and parsed.category is not None
+                                                and len(self.of_category(parsed.category))):
+                return parsed
         key = scope.kind if scope is not None else "all"
         if key not in self._scoped:
             sub_map, _ = time_scope.scoped_map(self.cmap, scope)
@@ -234,13 +251,17 @@ class Retriever:
             listed = self._list_changed(sub, scope, robot_xy)
             if listed is not None:
                 return listed
-        res = sub.query(scope.text if scope is not None else instruction, robot_xy)
+        if parsed is not None:
+            res = sub.query(parsed, None)
+        else:
+            assert scope is not None
+            res = sub.query(scope.text, robot_xy)
         gone = {o.id for o in self.cmap.retired}
         if res.chosen is not None and res.chosen.id in gone:
             return replace(res, chosen=None, found=False, score=0.0, distance_m=None, terms={},
                            reason=time_scope.gone_reason(res.chosen, self.cmap))
         if scope is None:
-            return None
+            return parsed
         if res.chosen is not None:
             res = replace(res, reason=f"{res.reason}; {time_scope.when_seen(res.chosen, self.cmap)}")
         return res
