@@ -397,7 +397,7 @@ def _build(wn: Any) -> dict[str, Any]:
         glosses[cat] = list(dict.fromkeys(t.strip() for t in texts if t.strip()))[:MAX_GLOSSES]
     return {"forms": dict(sorted(forms.items())), "alternatives": dict(sorted(alternatives.items())),
             "other": sorted(set(other)), "relations": relations, "glosses": glosses,
-            "foreign": _foreign(wn), "english": _english(), "not_typos": _not_typos(wn),
+            "foreign": _foreign(wn), "english": _english(), "not_typos": _not_typos(wn, forms),
             "source": "WordNet 3.0 (Princeton University), see WORDNET_LICENSE",
             "roots": ROOTS, "exclude": EXCLUDE}
 
@@ -407,15 +407,27 @@ TYPO_KEYWORDS = ["beside", "near", "next", "behind", "opposite", "front", "close
                  "furthest", "biggest", "largest", "smallest"]
 
 
-def _not_typos(wn: Any) -> list[str]:
+def typo_distance(word: str) -> int:
+    """The edit distance (optimal string alignment: a swap of two letters is one edit) within
+    which a word of this length is read as a typo of a known word: 1 up to five letters, else 2.
+    The parser (``capnav.retrieval.query.tokens``) uses the same rule."""
+    return 1 if len(word) <= 5 else 2
+
+
+def _not_typos(wn: Any, forms: dict[str, str]) -> list[str]:
     """Common English words (lower-case WordNet lemmas seen in its sense-tagged corpus, of similar
     length and with the same first letter) that look like a word the parser corrects typos
-    towards: "store" is no typo of "stove", nor "write" of "white"."""
+    towards: "store" is no typo of "stove", nor "write" of "white", nor "cactu" ... Every word
+    within ``typo_distance`` of a target (a category form of any length, a colour, a room or a
+    keyword) is one, besides difflib's close matches."""
     import difflib
+
+    from rapidfuzz.distance import OSA
 
     from capnav.language.colors import SHADES
 
     targets = {w for c in CATEGORIES for f in (c.name, *c.synonyms) for w in f.split()}
+    targets |= {w for f in forms for w in f.split() if len(w) >= 4 and w.isalpha()}
     targets |= {w + "s" for w in targets} | {w for f in (*LEXICON, *ALIASES, *SHADES) for w in f.split()}
     targets |= ROOM_WORDS | set(TYPO_KEYWORDS)
     # Candidates of similar length that share the first letter (typos rarely change it).
@@ -427,8 +439,35 @@ def _not_typos(wn: Any) -> list[str]:
     for t in sorted(targets):
         pool = [w for n in range(len(t) - 2, len(t) + 3) for w in by_key.get((t[0], n), [])]
         near.update(difflib.get_close_matches(t, pool, n=100, cutoff=0.75))
-    out = {w for w in near if any(lem.count() > 0 for lem in wn.lemmas(w) if lem.name() == w)}
+        near.update(w for w in pool if OSA.distance(w, t) <= typo_distance(w))
+    out = {w for w in near if _seen(wn, w)}
+    # The regular inflections of common words ("sheets", "swears", "charging") are words too.
+    by_len: dict[tuple[str, int], list[str]] = {}
+    for t in targets:
+        by_len.setdefault((t[0], len(t)), []).append(t)
+    for lemma in sorted({lem for group in by_key.values() for lem in group}):
+        for form in _inflections(lemma):
+            if form in targets or form in out:
+                continue
+            close = [t for n in range(len(form) - 2, len(form) + 3) for t in by_len.get((form[0], n), [])]
+            if any(OSA.distance(form, t) <= typo_distance(form) for t in close) and _seen(wn, lemma):
+                out.add(form)
     return sorted(out)
+
+
+def _seen(wn: Any, word: str) -> bool:
+    """Whether ``word`` occurs in lower case in WordNet's sense-tagged corpus."""
+    return any(lem.count() > 0 for lem in wn.lemmas(word) if lem.name() == word)
+
+
+def _inflections(lemma: str) -> list[str]:
+    """Regular plural / third person, past and -ing forms of ``lemma``."""
+    out = [lemma + "s", lemma + "es", lemma + "ed", lemma + "ing"]
+    if lemma.endswith("e"):
+        out += [lemma + "d", lemma[:-1] + "ing"]
+    if lemma.endswith("y"):
+        out += [lemma[:-1] + "ies", lemma[:-1] + "ied"]
+    return out
 
 
 def _other_stop_words() -> set[str]:

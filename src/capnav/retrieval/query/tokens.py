@@ -17,6 +17,7 @@ import re
 import unicodedata
 
 from rapidfuzz import fuzz, process
+from rapidfuzz.distance import OSA
 
 from capnav.core.categories import CATEGORIES
 from capnav.core.errors import InputError
@@ -76,11 +77,32 @@ def _form_follows(text: str, pos: int) -> bool:
     return any(word[:n] in _FORM_MAP and (len(word) == n or not (word[n].isalnum() or word[n] == "_"))
                for n in _FORM_LENGTHS if n <= len(word))
 
-#: Typos are matched against the vocabulary's own words only (not WordNet's 600 rarer ones).
+#: Misspelt multi-word names are matched against the vocabulary's own names.
 _TYPO_FORMS = {f: c.name for c in CATEGORIES for f0 in (c.name, *c.synonyms) for f in (f0, _plural(f0))}
 _MULTI_FORMS = sorted(f for f in _TYPO_FORMS if " " in f)
-_SINGLE_FORMS = sorted({f for f in _TYPO_FORMS if " " not in f and len(f) >= 4})
 _TYPO_WORDS = {w for f in _TYPO_FORMS for w in f.split()}
+#: A misspelt single word is matched against every single-word form (WordNet's and the
+#: vocabulary's, with plurals: "cacuts" is a cactus), by first letter: typos rarely change the
+#: first letter of a word, and "wellies" is no "tellies". The vocabulary's own names come first,
+#: so they win a tie.
+_SINGLE_BY_LETTER: dict[str, list[str]] = {}
+for _f in [*sorted(f for f in _TYPO_FORMS if " " not in f), *sorted(f for f in _FORM_MAP if " " not in f)]:
+    if len(_f) >= 4 and _f.isalpha() and _f not in _SINGLE_BY_LETTER.get(_f[0], []):
+        _SINGLE_BY_LETTER.setdefault(_f[0], []).append(_f)
+
+
+def typo_distance(word: str) -> int:
+    """The edit distance (optimal string alignment: two swapped letters are one edit) within which
+    ``word`` is read as a typo of a known word: 1 up to five letters, else 2 (the lexicon's
+    ``not_typos``, the real words that near, is built with the same rule)."""
+    return 1 if len(word) <= 5 else 2
+
+
+def _nearest(word: str, pool: list[str]) -> str | None:
+    """The word of ``pool`` (sharing ``word``'s first letter) within ``typo_distance`` of it, the
+    nearest first, else None."""
+    hit = process.extractOne(word, pool, scorer=OSA.distance, score_cutoff=typo_distance(word))
+    return None if hit is None else str(hit[0])
 #: rapidfuzz ratio (0-100) at which a misspelt multi-word name is read as that name: two letters
 #: wrong in "washing machine" (89.7) pass, a different word ("washing line") does not.
 _MULTI_TYPO_SCORE = 86.0
@@ -183,12 +205,15 @@ def _find_label(words: list[str], before: int) -> tuple[str, tuple[int, int], bo
 
 
 def _find_vocabulary(words: list[str]) -> tuple[str | None, tuple[int, int] | None, bool]:
-    """(category, word span, fuzzy) of the first category mention; exact n-grams before typos."""
+    """(category, word span, fuzzy) of the first category mention, exact or misspelt; at the same
+    word a longer name before a shorter one and an exact name before a typo."""
+    found: list[tuple[int, int, tuple[str, tuple[int, int], bool]]] = []  # (start, preference, hit)
     for n in (3, 2):
         for i in range(len(words) - n + 1):
             gram = " ".join(words[i:i + n])
             if gram in _FORM_MAP:
-                return _FORM_MAP[gram], (i, i + n), False
+                found.append((i, 3 - n, (_FORM_MAP[gram], (i, i + n), False)))
+                break
     # A typo in a multi-word name ("longe chair", "dinning tabel") before the exact single word
     # inside it ("chair"): rapidfuzz's normalised edit similarity (symmetric, unlike difflib's),
     # and only when every changed word is no English word of its own ("dining cable" is not a typo).
@@ -199,19 +224,24 @@ def _find_vocabulary(words: list[str]) -> tuple[str | None, tuple[int, int] | No
             if hit is not None and len(hit[0].split()) == n and all(
                     w == f or (w not in _FORM_WORDS and w not in _LEX.not_typos and w not in _ENGLISH_HINTS)
                     for w, f in zip(part, hit[0].split(), strict=True)):
-                return _TYPO_FORMS[hit[0]], (i, i + n), True
+                found.append((i, 2, (_TYPO_FORMS[hit[0]], (i, i + n), True)))
+                break
     for i in range(len(words)):
         if words[i] in _FORM_MAP:
-            return _FORM_MAP[words[i]], (i, i + 1), False
+            found.append((i, 3, (_FORM_MAP[words[i]], (i, i + 1), False)))
+            break
     for i, w in enumerate(words):
         if len(w) < 4 or w in _FILLER or canonical_color(w) or w in _SHAPES or w in _SIZE_WORDS \
-                or w in _LEX.not_typos or w in LABEL_MAP:
+                or w in _LEX.not_typos or w in LABEL_MAP or w in _FORM_MAP or not w.isalpha():
             continue
-        near = difflib.get_close_matches(w, _SINGLE_FORMS, n=1, cutoff=0.8)
+        near = _nearest(w, _SINGLE_BY_LETTER.get(w[0], []))
         # A word two or more letters short of a name's start is another word, not a typo ("wash").
-        if near and not (near[0].startswith(w) and len(near[0]) - len(w) >= 2):
-            return _TYPO_FORMS[near[0]], (i, i + 1), True
-    return None, None, False
+        if near and not (near.startswith(w) and len(near) - len(w) >= 2):
+            found.append((i, 4, (_FORM_MAP.get(near) or _TYPO_FORMS[near], (i, i + 1), True)))
+            break
+    if not found:
+        return None, None, False
+    return min(found, key=lambda t: (t[0], t[1]))[2]
 
 
 _COLOR_NOT_ALONE = {"light", "dark", "pale", "deep", "bright", "soft", "rich", "vivid", "dull", "muted", "dusty",
@@ -265,15 +295,38 @@ def _ratio(a: str, b: str) -> float:
     return difflib.SequenceMatcher(None, a, b).ratio()
 
 
+#: Short keywords and colours a three- or four-letter typo drops a letter of ("nxt" next, "blu"
+#: blue, "gren" green).
+_SHORT_KEYWORDS = sorted({w for w in ("next", "near", "hall", "room", "front", "behind", *LEXICON, *SHADES)
+                          if len(w) in (4, 5) and w.isalpha()})
+
+
 def _fix_keyword_typos(words: list[str]) -> list[str]:
+    """``words`` with misspelt keywords, colours, rooms and category names corrected: a word no
+    list knows as English, within ``typo_distance`` of a known word that starts with the same
+    letter ("ofice" office, "yelow" yellow, "cacuts" cactus, "plnat" plant); a three-letter word
+    or four-letter word that drops one letter of a keyword ("nxt" next, "blu" blue, "gren" green)."""
     out = []
     for w in words:
-        if len(w) >= 5 and w not in _ENGLISH_HINTS and w not in _FORM_WORDS and w not in _LEX.not_typos:
+        if w in _ENGLISH_HINTS or w in _FORM_WORDS or w in _LEX.not_typos or w in _COMMON_ADJECTIVES \
+                or not w.isalpha() or len(w) < 3:
+            out.append(w)
+            continue
+        fixed = None
+        if len(w) >= 5:
             near = difflib.get_close_matches(w, _KEYWORDS, n=1, cutoff=0.8)
             # Only when no category word is at least as close ("bedsde" is "bedside", not "beside").
-            if near and _ratio(w, near[0]) > max((_ratio(w, f) for f in _TYPO_WORDS), default=0.0):
-                w = near[0]
-        out.append(w)
+            if near and _ratio(w, near[0]) > max((_ratio(w, f) for f in _TYPO_WORDS if f != near[0]), default=0.0):
+                fixed = near[0]
+        if fixed is None and len(w) in (3, 4):
+            fixed = next((k for k in _SHORT_KEYWORDS if len(k) == len(w) + 1 and k[0] == w[0]
+                          and OSA.distance(w, k) == 1), None)
+        if fixed is None and len(w) >= 4 and not canonical_color(w) and w not in LABEL_MAP and w not in _SHAPES \
+                and w not in _SIZE_WORDS:
+            near_form = _nearest(w, _SINGLE_BY_LETTER.get(w[0], []))
+            if near_form and abs(len(near_form) - len(w)) <= 1:
+                fixed = near_form
+        out.append(fixed or w)
     return out
 
 
