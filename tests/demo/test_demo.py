@@ -34,6 +34,30 @@ def test_demo_runs_the_whole_loop(tmp_path: Path) -> None:
     # one id per object: the overview is the map (map ids, as in the answers); the truth picture says it is truth
     assert (tmp_path / "images" / "map.png").stat().st_size > 1000 and "images/map.png" in html
     assert "T-numbers are truth ids, not map ids" in html and "images/apartment.png" in html
+    for it in res.items:  # every drive is judged for the room and the heading too, and says so
+        if it.truth_distance is not None:
+            assert it.in_room is not None and it.facing_deg is not None
+            assert ("in its room" if it.in_room else "outside its room") in verdict(it)
+    assert "stops in the object's room, facing it (truth)" in res.report_md.read_text()
+
+
+def test_facing_is_the_heading_inside_the_angle_the_object_spans() -> None:
+    """Facing an object means pointing at some part of it: a 2 m sofa seen from its side counts,
+    a heading 90 degrees off its nearest corner does not (and says by how much)."""
+    import numpy as np
+
+    from capnav.demo.run import _off_facing_deg, _room_of
+
+    sofa = np.array([[1.0, -1.0], [1.8, -1.0], [1.8, 1.0], [1.0, 1.0]])
+    assert _off_facing_deg((0.0, 0.0, 0.0), sofa) == 0.0  # straight at it
+    assert _off_facing_deg((0.0, 0.0, np.radians(40)), sofa) == 0.0  # at its far end: still the sofa
+    assert _off_facing_deg((0.0, 0.0, np.pi), sofa) == pytest.approx(135.0)  # back to it
+    assert _off_facing_deg((1.4, 0.0, 2.0), sofa) == 0.0  # standing on it
+    off = _off_facing_deg((0.0, 0.0, np.radians(90)), sofa)
+    assert off == pytest.approx(45.0)  # 45 degrees past the corner at (1, 1)
+    rooms = [np.array([[0.0, 0.0], [3.0, 0.0], [3.0, 3.0], [0.0, 3.0]]),
+             np.array([[3.1, 0.0], [6.0, 0.0], [6.0, 3.0], [3.1, 3.0]])]
+    assert [_room_of(p, rooms) for p in ((1.0, 1.0), (4.0, 1.0), (3.05, 1.0))] == [0, 1, -1]
 
 
 def test_demo_user_instruction_that_matches_nothing_or_is_rejected(tmp_path: Path) -> None:

@@ -35,6 +35,8 @@ class ReportItem:
     correct: bool | None = None  # stopped within 1 m of a meant instance, by the simulator's truth (None: user text)
     right_object: bool | None = None  # the chosen map object lies on a meant instance (truth)
     truth_distance: float | None = None  # m from the stop to the nearest meant instance (truth)
+    in_room: bool | None = None  # the stop is in the room that instance stands in (truth)
+    facing_deg: float | None = None  # how far the final heading turns away from it (0: facing it)
     path_length: float | None = None
     nav_reason: str = ""
     view_png: str | None = None  # path relative to the report folder
@@ -70,6 +72,10 @@ def verdict(it: ReportItem) -> str:
     parts = ["reached" if it.reached else "not reached"]
     if it.right_object:
         parts.append("right object")
+    if it.in_room is not None:
+        parts.append("in its room" if it.in_room else "outside its room")
+    if it.facing_deg is not None:
+        parts.append("facing it" if it.facing_deg == 0.0 else f"turned {it.facing_deg:.0f}° away from it")
     return ", ".join(parts)
 
 

@@ -21,6 +21,7 @@ from rich.markup import escape
 from capnav.core.atomic import write_bytes, write_json
 from capnav.core.console import make_console
 from capnav.core.errors import CapNavError, InputError
+from capnav.core.footprint import footprint_distance
 from capnav.core.grid import FREE
 from capnav.core.limits import check_count, check_image_size
 from capnav.core.text import shorten
@@ -71,6 +72,28 @@ def _png(obj: MapObject) -> bytes | None:
     return None
 
 
+def _room_of(xy: Any, rooms: list[NDArray[np.float64]]) -> int:
+    """Index of the true room polygon holding ``xy`` (-1: in none, e.g. a doorway)."""
+    p = np.asarray(xy, dtype=np.float64).reshape(1, 2)
+    return next((k for k, poly in enumerate(rooms) if footprint_distance(p, poly)[0] == 0.0), -1)
+
+
+def _off_facing_deg(pose: tuple[float, float, float], footprint: NDArray[np.float64]) -> float:
+    """How far (degrees) the heading at ``pose`` turns away from the object: 0 when it points at some
+    part of the footprint (within the angle its corners span from the stop point, or standing on it)."""
+    x, y, yaw = pose
+    p = np.array([[x, y]], dtype=np.float64)
+    if footprint_distance(p, footprint)[0] == 0.0:
+        return 0.0
+    def wrap(a: Any) -> Any:
+        return (a + np.pi) % (2 * np.pi) - np.pi
+
+    centre = np.arctan2(footprint[:, 1].mean() - y, footprint[:, 0].mean() - x)
+    span = wrap(np.arctan2(footprint[:, 1] - y, footprint[:, 0] - x) - centre)  # corners, around the centre
+    lo, hi, h = float(span.min()), float(span.max()), float(wrap(yaw - centre))
+    return 0.0 if lo <= h <= hi else float(np.degrees(min(abs(wrap(h - lo)), abs(wrap(h - hi)))))
+
+
 def _next_instruction(cfg: DemoConfig, k: int, sim: Any, robot_xy: tuple[float, float]
                       ) -> tuple[str, str, list[int]] | None:
     """The k-th instruction (text, kind, target ids): the user's, or one generated for the k-th kind
@@ -100,6 +123,7 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
     starts = start_cells(sim.nav_grid().clearance, nav_truth.cells == FREE,
                          PlannerConfig().inflation + nav_truth.spec.resolution)
     footprints = {o.id: np.asarray(o.footprint, dtype=np.float64) for o in sim.manifest.objects}
+    rooms = [np.asarray(r.polygon, dtype=np.float64) for r in sim.manifest.rooms]
     con.print(f"     {len(sim.manifest.rooms)} rooms, {len(sim.manifest.objects)} objects "
               f"({time.perf_counter() - t0:.1f} s)")
     from capnav.viz.scene import draw_scene
@@ -134,7 +158,8 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
             con.print(f"     (this apartment allows no {cfg.kinds[k]!r} instruction; skipped)")
             continue
         text, kind, targets = nxt
-        it = _answer(len(items) + 1, text, kind, targets, retriever, agent, cmap, assets, footprints, pcfg_plan, out)
+        it = _answer(len(items) + 1, text, kind, targets, retriever, agent, cmap, assets, footprints, rooms,
+                     pcfg_plan, out)
         items.append(it)
         con.print(f"     {len(items)}. \\[{kind}] {escape(repr(shorten(text)))}: {it.chosen_label or '-'}: "
                   f"{escape(verdict(it))}")
@@ -142,12 +167,15 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
     con.print("[bold]4/4[/] writing the report")
     timings["total"] = time.perf_counter() - t0
     judged = [it for it in items if it.correct is not None]
+    driven = [it for it in items if it.in_room is not None]
     summary = [
         ("apartment seed", str(cfg.seed)),
         ("rooms / objects (truth)", f"{len(sim.manifest.rooms)} / {len(sim.manifest.objects)}"),
         ("frames explored", str(len(assets.stream()))),
         ("objects in the map", str(len(cmap.objects))),
         ("instructions right (truth)", f"{sum(bool(it.correct) for it in judged)} / {len(judged)}"),
+        ("stops in the object's room, facing it (truth)",
+         f"{sum(bool(it.in_room) and it.facing_deg == 0.0 for it in driven)} / {len(driven)}"),
         ("time (s)", ", ".join(f"{k} {v:.1f}" for k, v in timings.items())),
     ]
     from capnav.viz.mapimage import map_picture
@@ -164,8 +192,8 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
 
 
 def _answer(k: int, text: str, kind: str, targets: list[int], retriever: Retriever, agent: Any, cmap: Any,
-            assets: SimScene, footprints: dict[int, NDArray[np.float64]], plan_cfg: PlannerConfig,
-            out: Path) -> ReportItem:
+            assets: SimScene, footprints: dict[int, NDArray[np.float64]], rooms: list[NDArray[np.float64]],
+            plan_cfg: PlannerConfig, out: Path) -> ReportItem:
     try:
         res = run_instruction(cmap, assets.sim, retriever, text, agent=agent, config=plan_cfg,
                               out_dir=out / "images", stem=f"{k:02d}_nav")
@@ -186,6 +214,9 @@ def _answer(k: int, text: str, kind: str, targets: list[int], retriever: Retriev
             item.right_object = near in targets
         if nav is not None:
             item.truth_distance = distance_to_instances(nav.final_pose[:2], fps)
+            meant = fps[int(np.argmin([distance_to_instances(nav.final_pose[:2], [f]) for f in fps]))]
+            item.in_room = _room_of(nav.final_pose[:2], rooms) == _room_of(meant.mean(axis=0), rooms) >= 0
+            item.facing_deg = _off_facing_deg(nav.final_pose, meant)
         item.correct = item.truth_distance is not None and item.truth_distance <= SUCCESS_RADIUS_M
     if obj is not None and (view := _png(obj)):
         item.view_png = f"images/{k:02d}_view.png"
