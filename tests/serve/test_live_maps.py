@@ -26,10 +26,11 @@ def _without_last_object(src: Path, dest: Path) -> None:
     save_map(cmap, dest)
 
 
-def test_reload_swaps_a_replaced_file_without_dropping_asks(served_map: Path, tmp_path: Path) -> None:
+@pytest.mark.parametrize("pool", ["threads", "processes"])
+def test_reload_swaps_a_replaced_file_without_dropping_asks(served_map: Path, tmp_path: Path, pool: str) -> None:
     path = tmp_path / "home.capnav"
     shutil.copy(served_map, path)
-    with live(create_app(path, CFG)) as (url, _):
+    with live(create_app(path, ServeConfig(workers=2, rate=0, pool=pool))) as (url, _):
         assert httpx.get(url + "/api/map").json()["version"] == 1
         codes: list[int] = []
         stop = threading.Event()

@@ -35,7 +35,9 @@ def register(app: typer.Typer) -> None:
         token: Annotated[str | None, typer.Option(
             help=f"bearer token every /api request must carry (default: ${TOKEN_ENV}); required off loopback")
                          ] = None,
-        workers: Annotated[int, typer.Option(min=1, max=64, help="worker threads that answer asks")] = 2,
+        workers: Annotated[int, typer.Option(min=1, max=64, help="workers that answer asks (one per core)")] = 2,
+        pool: Annotated[str, typer.Option(help="processes (a GIL each: asks run side by side and /healthz never "
+                                               "waits behind them) or threads (less memory)")] = "processes",
         queue: Annotated[int, typer.Option(min=0, help="asks that may wait for a worker (more: 503)")] = 64,
         time_limit: Annotated[float, typer.Option(min=0.01, help="seconds an ask may take (else 503)")] = 10.0,
         body_timeout: Annotated[float, typer.Option(min=0.01, help="seconds to receive a request body")] = 10.0,
@@ -79,7 +81,7 @@ def register(app: typer.Typer) -> None:
                                                                 if p.is_dir() else ""))
         cfg = ServeConfig(max_body=max_body, rate=rate, burst=burst, workers=workers, queue=queue,
                           time_limit=time_limit, body_timeout=body_timeout, token=token, access_log=access_log,
-                          load_in_background=True)
+                          load_in_background=True, pool=pool)
         opts = AskOptions(embedder, embedder_path, verifier)
         app = create_app(list(map_paths), cfg, opts)
         handler = logging.StreamHandler(sys.stderr)
@@ -104,7 +106,7 @@ def register(app: typer.Typer) -> None:
                 except Exception as e:
                     con.print(f"[red]error:[/] a worker failed to load: {e}", highlight=False)
                     return
-                con.print(f"ready: {len(maps)} map(s), {app.state.pool.workers} workers", highlight=False)
+                con.print(f"ready: {len(maps)} map(s), {app.state.pool.workers} worker {pool}", highlight=False)
 
             threading.Thread(target=ready, daemon=True).start()
 
@@ -112,9 +114,10 @@ def register(app: typer.Typer) -> None:
             result = await app.state.reload()
             con.print("SIGHUP: " + "; ".join(f"{k}: {v}" for k, v in result.items()), highlight=False)
 
-        # The event loop shares the GIL with the worker threads: hand it over every 1 ms instead of
-        # Python's 5 ms, so /healthz and the page wait less behind asks that hold it.
-        sys.setswitchinterval(0.001)
+        if pool == "threads":
+            # The event loop shares the GIL with the worker threads: hand it over every 1 ms instead of
+            # Python's 5 ms, so /healthz and the page wait less behind asks that hold it.
+            sys.setswitchinterval(0.001)
         config = uvicorn.Config(app, host=host, port=port, log_level="warning", access_log=False,
                                 http=header_protocol(header_timeout), timeout_keep_alive=5,
                                 timeout_graceful_shutdown=int(max(1.0, time_limit + 5)), lifespan="on")

@@ -2,8 +2,10 @@
 
 The maps, the embedder and the planner's costmaps load once and stay, so each question costs
 milliseconds. The event loop only parses requests and writes answers: asks and plans run on a
-bounded pool of worker threads (``serve.pool``), each with its own ``CapNav`` per map, so
-``/healthz``, ``/readyz``, the page and the map picture answer while asks run. Several maps are
+bounded pool of workers, each with its own ``CapNav`` per map: processes (``serve.procpool``,
+what ``capnav serve`` runs: each has a GIL of its own) or threads (``serve.pool``, for maps
+handed over in memory), so ``/healthz``, ``/readyz``, the page and the map picture answer while
+asks run. Several maps are
 served under their names (``/api/maps/{name}/...``); the unnamed routes (``/api/query``, ...)
 serve the first map. Bad input is a 4xx JSON ``{"error": why}``; a full or late pool is a 503
 with the reason.
@@ -13,10 +15,10 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
 import logging
 import math
 import threading
-import time
 from collections.abc import AsyncIterator, Callable, Sequence
 from dataclasses import dataclass
 from importlib import resources
@@ -32,12 +34,13 @@ from starlette.routing import Route
 from capnav.api import CapNav
 from capnav.core.errors import CapNavError, InputError, ModelError, NotFoundError
 from capnav.mapping.cmap import CapNavMap
-from capnav.planning.position import place_robot
 from capnav.serve.edges import AccessLog, BearerToken, BodyDeadline
+from capnav.serve.jobs import plan_job, process_state, query_job
 from capnav.serve.jsonbody import parse_bounded
 from capnav.serve.limits import BodyLimit, RateLimit
 from capnav.serve.maps import AskOptions, ServedMap, WorkerState, default_robot, map_name, unique_names
 from capnav.serve.pool import Busy, Overtime, WorkPool
+from capnav.serve.procpool import ProcessPool
 
 __all__ = ["ServeConfig", "create_app", "default_robot"]
 
@@ -48,12 +51,17 @@ _STATIC = {"index.html": "text/html; charset=utf-8", "app.js": "text/javascript;
            "style.css": "text/css; charset=utf-8"}
 
 
+#: ``ServeConfig.pool``: worker processes (a GIL each) or worker threads (maps in memory).
+POOLS = ("processes", "threads")
+
+
 @dataclass(frozen=True)
 class ServeConfig:
     """Limits of the server. Requests: bodies up to ``max_body`` bytes, JSON nested at most
     ``max_depth`` deep with at most ``max_elements`` values, the whole body within
     ``body_timeout`` s; ``rate`` requests per second per client with bursts of ``burst`` (0 = no
-    rate limit); at most ``max_k`` runners-up. Work: ``workers`` threads, ``queue`` asks waiting
+    rate limit); at most ``max_k`` runners-up. Work: ``workers`` threads or processes (``pool``;
+    processes need maps given as files), ``queue`` asks waiting
     beyond them (more: 503), each ask answered within ``time_limit`` s (else 503). ``token``: the
     bearer token every ``/api`` request must carry (None: none needed)."""
 
@@ -73,6 +81,7 @@ class ServeConfig:
     #: Listen before the maps and the embedder are loaded (``/readyz`` says when they are); False
     #: waits in the start-up hook, as a test client or an embedding application expects.
     load_in_background: bool = False
+    pool: str = "threads"
 
     def __post_init__(self) -> None:
         if self.max_body < 256 or self.rate < 0 or self.burst < 1 or self.max_k < 0:
@@ -81,6 +90,8 @@ class ServeConfig:
             raise InputError("ServeConfig: workers >= 1, queue >= 0, time_limit > 0 and body_timeout > 0 are required")
         if self.max_depth < 2 or self.max_elements < 4:
             raise InputError("ServeConfig: max_depth >= 2 and max_elements >= 4 are required")
+        if self.pool not in POOLS:
+            raise InputError(f"ServeConfig: pool must be one of {', '.join(POOLS)}, got {self.pool!r}")
         if self.token is not None and len(self.token) < 8:
             raise InputError("the bearer token must be at least 8 characters")
 
@@ -175,16 +186,27 @@ def create_app(maps: MapInput | Sequence[MapInput], config: ServeConfig | None =
         for k, m in enumerate(served):  # in-memory maps: number them
             m.name = f"{m.name}-{k + 1}" if names.count(m.name) > 1 else m.name
     mapset = MapSet(served)
-    workers = 1 if any(m.options.shared_instance for m in served) else cfg.workers
+    processes = cfg.pool == "processes"
+    pool: WorkPool[WorkerState] | ProcessPool
+    if processes:
+        if not all(isinstance(i, str | Path) for i in items):
+            raise InputError("worker processes open the maps from their files: give map file paths, or serve maps "
+                             "in memory with ServeConfig(pool='threads')")
+        pool = ProcessPool(cfg.workers, cfg.queue,
+                           functools.partial(process_state, [m.ref() for m in served], cfg.warm_up))
+    else:
+        def make_state(i: int) -> WorkerState:
+            st = WorkerState()
+            if cfg.warm_up:
+                for m in mapset.all():
+                    st.warm(m)
+            return st
 
-    def make_state(i: int) -> WorkerState:
-        st = WorkerState()
-        if cfg.warm_up:
-            for m in mapset.all():
-                st.warm(m)
-        return st
+        workers = 1 if any(m.options.shared_instance for m in served) else cfg.workers
+        pool = WorkPool(workers, cfg.queue, make_state)
 
-    pool: WorkPool[WorkerState] = WorkPool(workers, cfg.queue, make_state)
+    def job_map(m: ServedMap) -> Any:
+        return m.ref() if processes else m
     reload_lock = asyncio.Lock()
 
     async def reload_maps() -> dict[str, str]:
@@ -265,7 +287,7 @@ def create_app(maps: MapInput | Sequence[MapInput], config: ServeConfig | None =
             return _error(404, f"object {oid} has no captioning view")
         return Response(png, media_type="image/png")
 
-    async def work(request: Request, job: Callable[[WorkerState, float], Any]) -> Response:
+    async def work(request: Request, job: Callable[[WorkerState, float], bytes]) -> Response:
         if not pool.ready:
             why = f"a worker failed to load: {pool.load_error}" if pool.load_error is not None else \
                 "still loading the maps and the embedder (see /readyz)"
@@ -282,7 +304,7 @@ def create_app(maps: MapInput | Sequence[MapInput], config: ServeConfig | None =
             return _error(422, str(e))
         except ModelError as e:
             return _error(503, f"a model backend failed: {e}")
-        return JSONResponse(out)
+        return Response(out, media_type="application/json")
 
     async def query(request: Request) -> Response:
         m = chosen_map(request)
@@ -297,8 +319,7 @@ def create_app(maps: MapInput | Sequence[MapInput], config: ServeConfig | None =
             robot = _robot(body.get("robot"))
         except InputError as e:
             return _error(422, str(e))
-        return await work(request, lambda st, deadline: ask_job(st.nav(m), text, k, robot, deadline) | {
-            "map": m.name, "map_version": m.version})
+        return await work(request, functools.partial(query_job, job_map(m), text, k, robot))
 
     async def plan_route(request: Request) -> Response:
         m = chosen_map(request)
@@ -310,7 +331,7 @@ def create_app(maps: MapInput | Sequence[MapInput], config: ServeConfig | None =
             start = _robot(body.get("start"), "start")  # None: the map's last camera pose
         except InputError as e:
             return _error(422, str(e))
-        return await work(request, lambda st, deadline: st.nav(m).plan(start, oid).to_dict())
+        return await work(request, functools.partial(plan_job, job_map(m), oid, start))
 
     async def http_error(request: Request, exc: Exception) -> Response:
         assert isinstance(exc, HTTPException)
@@ -356,39 +377,6 @@ async def _json_body(request: Request, cfg: ServeConfig) -> dict[str, Any]:
     if not isinstance(body, dict):
         raise HTTPException(422, f"the body must be a JSON object, got {type(body).__name__}")
     return body
-
-
-def ask_job(nav: CapNav, text: str, k: int, robot: tuple[float, float, float] | None, deadline: float
-            ) -> dict[str, Any]:
-    """One ask on a worker: the answer, and with a robot position its goal pose and A* path (the
-    path is left out, with a note, when the time limit is reached after the goal pose)."""
-    t0, c0 = time.perf_counter(), time.thread_time()
-    note, start = "", None
-    if robot is not None:
-        xy, note = place_robot(nav.occupancy, robot[:2])
-        start = (xy[0], xy[1], robot[2])
-    ans = nav.ask(text, robot=None if start is None else start[:2], k=k)
-    _t1, c1 = time.perf_counter(), time.thread_time()
-    plan, plan_note = None, ""
-    if start is not None and ans.goal is not None:
-        if time.monotonic() < deadline:
-            plan = nav.plan(start, ans)
-        else:
-            plan_note = "no path: the time limit was reached once the goal pose was chosen"
-    t2, c2 = time.perf_counter(), time.thread_time()
-    out = ans.to_dict()
-    out["chosen"] = out["object"]  # the CLI's name; "object" stays one release for older clients
-    details = ans.result.details
-    for i, r in enumerate(out["runners_up"]):
-        d = details[i] if i < len(details) else {}
-        r["why"] = d.get("why", "")
-        r["terms"] = d.get("terms", {})
-    out["robot_note"] = note
-    out["plan"] = None if plan is None else plan.to_dict()
-    out["plan_note"] = plan_note
-    out["server_ms"] = {"wall": round((t2 - t0) * 1e3, 3), "cpu": round((c2 - c0) * 1e3, 3),
-                        "ask_cpu": round((c1 - c0) * 1e3, 3), "plan_cpu": round((c2 - c1) * 1e3, 3)}
-    return out
 
 
 def _static(name: str) -> Response:

@@ -60,6 +60,16 @@ def default_robot(nav: CapNav) -> tuple[float, float] | None:
     return (round(float(x), 3), round(float(y), 3))
 
 
+@dataclass(frozen=True)
+class MapRef:
+    """A served map as a worker process knows it: its name, file and version (it pickles)."""
+
+    name: str
+    path: Path
+    version: int
+    options: AskOptions
+
+
 def _stamp(path: Path | None) -> tuple[int, int] | None:
     if path is None:
         return None
@@ -109,6 +119,13 @@ class ServedMap:
         return CapNav(n.map, embedder=embedder, verifier=self.options.verifier, retrieval=n.retrieval_config,
                       planner=n.planner_config, source=self.path)
 
+    def ref(self) -> MapRef:
+        """How a worker process names this map (only a map opened from a file has one)."""
+        if self.path is None or self.options.shared_instance:
+            raise InputError(f"map {self.name!r} was given in memory (or with a ready embedder object): worker "
+                             "processes open maps from their files; serve it with worker threads")
+        return MapRef(self.name, self.path, self.version, self.options)
+
     def changed_on_disk(self) -> bool:
         return self.path is not None and _stamp(self.path) != self.stamp
 
@@ -154,6 +171,17 @@ class WorkerState:
     def __init__(self) -> None:
         self.embedders: dict[tuple[Any, ...], TextEmbedder] = {}
         self.navs: dict[str, tuple[int, CapNav]] = {}
+        self.opened: dict[str, ServedMap] = {}
+
+    def served(self, m: ServedMap | MapRef) -> ServedMap:
+        """The map a job names: the server's own object (worker threads), or in a worker process
+        the file opened here, again when the server has reloaded it (a newer version)."""
+        if isinstance(m, ServedMap):
+            return m
+        have = self.opened.get(m.name)
+        if have is None or have.version < m.version:
+            have = self.opened[m.name] = ServedMap.open(m.path, m.options, m.name, m.version)
+        return have
 
     def nav(self, m: ServedMap) -> CapNav:
         have = self.navs.get(m.name)
