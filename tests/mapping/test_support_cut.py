@@ -9,51 +9,15 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from _synth_scene import HashEmbedder
+from _true_boxes import TrueBoxDetector
 
-from capnav.core.categories import BY_NAME
 from capnav.core.frame import Frame
 from capnav.eval.surface_quality import assign, relative_size_error, surface_report
 from capnav.mapping import MapperConfig, build_map
 from capnav.mapping.lifting import LiftConfig
 from capnav.mapping.support import SupportCutConfig
-from capnav.perception import Detection, Detector, create_encoder
-from capnav.perception.box_masks import depth_box_masks, floor_pixels, up_facing_pixels
+from capnav.perception import create_encoder
 from capnav.sim import CameraConfig, LayoutConfig, SimConfig, Simulator
-
-
-class TrueBoxDetector(Detector):
-    """Boxes from the truth images (grown 5%), masks from depth as the COCO detectors make them:
-    only the box reaches the mapper, never the instance mask. Things score higher than furniture
-    (a cup is easy, a table half hidden under its things is not)."""
-
-    id = "test:true-boxes"
-    needs_truth = True
-
-    def __init__(self, labels: dict[int, str]) -> None:
-        self.labels = labels
-
-    def detect(self, frame: Frame) -> list[Detection]:
-        assert frame.gt_instance is not None
-        inst = np.asarray(frame.gt_instance)
-        h, w = inst.shape
-        boxes, names = [], []
-        for iid, name in self.labels.items():
-            vs, us = np.nonzero(inst == iid)
-            if vs.size < 30:
-                continue
-            gx, gy = 0.025 * (us.max() - us.min() + 1), 0.025 * (vs.max() - vs.min() + 1)
-            boxes.append((max(0.0, us.min() - gx), max(0.0, vs.min() - gy), min(float(w), us.max() + 1 + gx),
-                          min(float(h), vs.max() + 1 + gy)))
-            names.append(name)
-        floor = floor_pixels(frame.depth, frame.K, frame.T_wc, 0.05)
-        out = []
-        up = up_facing_pixels(frame.depth, frame.K, frame.T_wc)
-        for b, name, m in zip(boxes, names, depth_box_masks(frame.depth, boxes, exclude=floor, up=up), strict=True):
-            if m.sum() < 10:
-                continue
-            cat = BY_NAME.get(name)
-            out.append(Detection(b, cat.id if cat else 0, name, 0.5 if cat else 0.9, m))
-        return out
 
 
 def _look(eye: np.ndarray, target: np.ndarray) -> np.ndarray:

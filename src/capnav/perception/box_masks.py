@@ -242,8 +242,8 @@ def depth_kinks(z: NDArray[np.floating], ok: NDArray[np.bool_], kink: float = 0.
     return out
 
 
-def _attach(z: NDArray[np.float64], labels: NDArray[np.int64], free: NDArray[np.bool_], tol: NDArray[np.float64]
-            ) -> NDArray[np.int64]:
+def attach_to_nearest(z: NDArray[np.float64], labels: NDArray[np.int64], free: NDArray[np.bool_],
+                      tol: NDArray[np.float64]) -> NDArray[np.int64]:
     """Give each ``free`` pixel the label of its 8-neighbour of nearest depth (within ``tol``)."""
     best = np.full(z.shape, np.inf)
     out = labels.copy()
@@ -277,8 +277,8 @@ def surface_mask(depth: NDArray[np.floating], box_px: tuple[int, int, int, int],
                  exclude: NDArray[np.bool_] | None = None, extent: float = 1.5, gap: float = 0.04,
                  gap_rel: float = 0.02, ring: float = 0.1, side_frac: float = 0.3, hidden_frac: float = 0.5,
                  min_valid: int = 4, min_share: float = 0.02, front: float = 0.75, kink: float = 0.03,
-                 max_leads: int = 8, fill_tol: float = 0.8, up: NDArray[np.bool_] | None = None
-                 ) -> NDArray[np.bool_] | None:
+                 max_leads: int = 8, fill_tol: float = 0.8, up: NDArray[np.bool_] | None = None,
+                 min_occlusion: float = 0.25) -> NDArray[np.bool_] | None:
     """The object's own surfaces in the pixel window ``box_px`` (x0, y0, x1, y1), or None.
 
     A box from a detector frames one object; what else it catches is background, seen around
@@ -289,10 +289,12 @@ def surface_mask(depth: NDArray[np.floating], box_px: tuple[int, int, int, int],
     the wall behind it, which a slanted view shows with neither a jump nor a crease in depth, is
     never one surface with it); cut pixels rejoin
     the neighbour of nearest depth. For each surface: its pixels in the box, how much of each ring
-    side (above, below, left, right of the box) it covers, and the share of its outline (next to
-    anything else, the floor and invalid pixels included; given ``up``, next to other surfaces
-    only, so that the wall seen under a table between its legs is hidden although it also
-    borders the floor) where it is the far side (``hidden``).
+    side (above, below, left, right of the box) it covers (the outer half of the strip: a surface
+    there runs on past the box, not just over a tight box's edge; a strip the image border clips
+    to less than half its width says nothing), and the share of its occluding outline (depth
+    jumps to its neighbours; without ``up`` the floor and invalid pixels count too; at least
+    ``min_occlusion`` of its whole outline) where it is the far side (``hidden``): the wall seen
+    under a table between its legs is hidden, a seat meeting the sofa's front at a crease is not.
     A surface covering at least ``side_frac`` of two ring sides runs on past the object (a wall,
     the floor, a far room) and is background. Each of the ``max_leads`` largest surfaces (at
     least ``min_share`` of the box's valid pixels, not mostly hidden) leads a group; the surfaces
@@ -335,7 +337,7 @@ def surface_mask(depth: NDArray[np.floating], box_px: tuple[int, int, int, int],
         labels, n = ndimage.label(ok & ~jump)
     if n == 0:
         return None
-    labels = _attach(z, labels.astype(np.int64), ok & jump, tol)
+    labels = attach_to_nearest(z, labels.astype(np.int64), ok & jump, tol)
     nb = n + 1
     n_in = np.bincount(labels[inb], minlength=nb).astype(np.float64)
     n_in[0] = 0.0
@@ -343,13 +345,20 @@ def surface_mask(depth: NDArray[np.floating], box_px: tuple[int, int, int, int],
     zmean = np.bincount(labels.ravel(), weights=z.ravel(), minlength=nb) / np.maximum(count, 1.0)
     sides = np.zeros(nb, dtype=np.int64)
     rows, cols = slice(r0 - R0, r1 - R0), slice(c0 - C0, c1 - C0)
-    for strip in (labels[: r0 - R0, cols], labels[r1 - R0:, cols], labels[rows, : c0 - C0], labels[rows, c1 - C0:]):
-        if strip.size:
+    # Each side's evidence is the outer half of its ring strip (a surface there runs on past the box,
+    # not over a tight box's edge); a strip the image border clips to less than half its width is no
+    # evidence either way (an object cut by the border fills what is left of it).
+    ht, hb, wl, wr = r0 - R0, R1 - r1, c0 - C0, C1 - c1
+    outer = ((labels[: (ht + 1) // 2, cols], ht, mr), (labels[R1 - R0 - (hb + 1) // 2:, cols], hb, mr),
+             (labels[rows, : (wl + 1) // 2], wl, mc), (labels[rows, C1 - C0 - (wr + 1) // 2:], wr, mc))
+    for strip, width, full in outer:
+        if strip.size and 2 * width >= full:
             sides += np.bincount(strip.ravel(), minlength=nb) >= side_frac * strip.size
     background = sides >= 2
     # Outline pairs (4-neighbours with different labels): which side is farther.
     hid = np.zeros(nb)
     edge = np.zeros(nb)
+    jedge = np.zeros(nb)
     pairs: list[NDArray[np.int64]] = []
     for a_l, b_l, a_z, b_z in ((labels[1:], labels[:-1], z[1:], z[:-1]),
                                (labels[:, 1:], labels[:, :-1], z[:, 1:], z[:, :-1])):
@@ -360,10 +369,17 @@ def surface_mask(depth: NDArray[np.floating], box_px: tuple[int, int, int, int],
             edge += np.bincount(a_l[diff], minlength=nb) + np.bincount(b_l[diff], minlength=nb)
         else:  # only against other surfaces: the wall under a table, between its legs, borders the floor
             edge += np.bincount(la, minlength=nb) + np.bincount(lb, minlength=nb)
-        hid += np.bincount(la, weights=(za > zb).astype(np.float64), minlength=nb)
-        hid += np.bincount(lb, weights=(zb > za).astype(np.float64), minlength=nb)
+        # Only a depth jump occludes: at a crease (a seat meeting the sofa's front, a table top its
+        # edge) neither surface hides behind the other.
+        jmp = np.abs(za - zb) > gap + gap_rel * np.maximum(za, zb)
+        jedge += np.bincount(la, weights=jmp.astype(np.float64), minlength=nb)
+        jedge += np.bincount(lb, weights=jmp.astype(np.float64), minlength=nb)
+        if up is None:  # without the pose the floor and invalid pixels count as a non-hiding outline
+            jedge += np.bincount(a_l[diff & ~pair], minlength=nb) + np.bincount(b_l[diff & ~pair], minlength=nb)
+        hid += np.bincount(la, weights=((za > zb) & jmp).astype(np.float64), minlength=nb)
+        hid += np.bincount(lb, weights=((zb > za) & jmp).astype(np.float64), minlength=nb)
         pairs.append(np.stack([la, lb]))
-    hidden = hid / np.maximum(edge, 1.0)
+    hidden = hid / np.maximum(np.maximum(jedge, min_occlusion * edge), 1.0)
     lead = ~background & (n_in >= max(float(min_valid), min_share * n_valid)) & (hidden <= hidden_frac)
     lead[0] = False
     if not lead.any():
@@ -443,6 +459,12 @@ def floor_pixels(depth: NDArray[np.floating], K: Any, T_wc: NDArray[np.floating]
 
 def depth_box_masks(depth: NDArray[np.floating], boxes: Sequence[Box], band: float = 0.4,
                     exclude: NDArray[np.bool_] | None = None, up: NDArray[np.bool_] | None = None,
-                    **kw: float) -> list[NDArray[np.bool_]]:
-    """``depth_box_mask`` for every box of one frame."""
-    return [depth_box_mask(depth, b, band=band, exclude=exclude, up=up, **kw) for b in boxes]  # type: ignore[arg-type]
+                    K: Any | None = None, **kw: float) -> list[NDArray[np.bool_]]:
+    """``depth_box_mask`` for every box of one frame; given the intrinsics ``K``, each mask keeps
+    only its pieces that make one thing in 3D (``box_pieces.linked_pieces``)."""
+    masks = [depth_box_mask(depth, b, band=band, exclude=exclude, up=up, **kw) for b in boxes]  # type: ignore[arg-type]
+    if K is None:
+        return masks
+    from capnav.perception.box_pieces import linked_pieces  # it builds on this module's surfaces
+
+    return [linked_pieces(m, depth, K) for m in masks]

@@ -154,7 +154,7 @@ class CocoDetector(Detector):
         floor = None if self.floor_height is None else floor_pixels(depth, frame.K, frame.T_wc, self.floor_height)
         up = None if floor is None else up_facing_pixels(depth, frame.K, frame.T_wc)  # pose trusted like the floor
         raw = depth_box_masks(depth, box_list, band=self.depth_band, exclude=floor, extent=self.depth_extent,
-                              up=up)
+                              up=up, K=frame.K)
         return [m & filled_box_mask(b, (h, w)) for m, b in zip(raw, box_list, strict=True)]
 
     def detect(self, frame: Frame) -> list[Detection]:
