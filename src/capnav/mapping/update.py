@@ -16,8 +16,9 @@ the old map; never from a simulator's list of changes or its instance ids.
    colour, size, descriptor) is that object moved (same id, a pose history); the rest are born.
    Old objects observed empty and not found elsewhere are retired (kept, with when they were last
    seen, never returned as present).
-3. Voxels seen through are carved, the new frames' voxels fused in, and the occupancy grid is
-   derived again.
+3. Voxels seen through are carved, and so is the surface of every object that left its place
+   (unless the new recording saw it); the detected frames' voxels are fused in, and the depth of
+   frames that saw an old place empty (the floor it stood on); the occupancy grid is derived again.
 """
 
 from __future__ import annotations
@@ -101,6 +102,7 @@ class UpdateReport:
     recording: int
     frames: int = 0
     frames_detected: int = 0
+    frames_depth_only: int = 0  # frames that saw an old place empty: depth fused, no detection
     present: list[int] = field(default_factory=list)  # old objects confirmed at their place
     moved: list[int] = field(default_factory=list)
     retired: list[int] = field(default_factory=list)
@@ -111,7 +113,8 @@ class UpdateReport:
     registration: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
-        return {k: getattr(self, k) for k in ("recording", "frames", "frames_detected", "present", "moved", "retired",
+        return {k: getattr(self, k) for k in ("recording", "frames", "frames_detected", "frames_depth_only", "present",
+                                              "moved", "retired",
                                               "born", "unobserved", "voxels_carved", "registration")} | {
             "cpu_seconds": round(self.cpu_seconds, 3)}
 
@@ -119,7 +122,7 @@ class UpdateReport:
         return (f"recording {self.recording}: {len(self.present)} objects confirmed, {len(self.moved)} moved "
                 f"{self.moved}, {len(self.retired)} retired {self.retired}, {len(self.born)} new {self.born}, "
                 f"{len(self.unobserved)} not in view; detector ran on {self.frames_detected} of {self.frames} "
-                f"frames; {self.voxels_carved} voxels carved free")
+                f"frames (depth alone fused in {self.frames_depth_only}); {self.voxels_carved} voxels carved free")
 
 
 # ---- recordings ------------------------------------------------------------------------------
@@ -357,6 +360,16 @@ def _merge_voxels(old: VoxelMap, keep: NDArray[np.bool_], new: VoxelMap) -> Voxe
     return VoxelMap.from_arrays(old.resolution, old.origin, unpack_keys(Ko), C, W, F, old.projection, old.text_space)
 
 
+def _fuse_depth(mapper: Mapper, frame: Frame) -> None:
+    """Fuse a frame's depth and colour into ``mapper``'s voxels without running the detector."""
+    grid, table = mapper.encoder.encode_indexed(frame, [])
+    table = np.asarray(table, dtype=np.float32)
+    proj = mapper.voxels.project(table) if mapper.voxels.projection is not None else table
+    vc = mapper.config.voxel
+    mapper.voxels.integrate_frame(frame.depth, frame.rgb, frame.K, frame.T_wc, np.asarray(grid, dtype=np.int64), proj,
+                                  vc.sigma, vc.max_depth, vc.pixel_stride)
+
+
 # ---- the update ----------------------------------------------------------------------------
 def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encoder: DenseFeatureEncoder,
                transform: NDArray[np.float64] | None = None, config: UpdateConfig | None = None,
@@ -422,9 +435,10 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
             v_seen += vcodes == E_.SEEN
             v_through += vcodes == E_.THROUGH
         rep.frames += 1
-        # A frame shows a change when it holds surface the map lacks, or sees through an old object's
-        # place: its depth is fused there too (the floor where a chair stood becomes free).
-        changed = not cfg.gate or emptied or _new_share(f, Twc, known, cfg) >= cfg.new_share
+        # A frame shows something new when it holds surface the map lacks: it and its neighbours run
+        # the detector. One that sees through an old object's place only has its depth fused (the
+        # floor where a chair stood becomes free): what is gone needs no detection.
+        changed = not cfg.gate or _new_share(f, Twc, known, cfg) >= cfg.new_share
         if changed:
             while pending:
                 g = pending.popleft()
@@ -436,6 +450,9 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
             detected.append(f.index)
             if not changed:
                 tail -= 1
+        elif emptied:
+            _fuse_depth(mapper, f)
+            rep.frames_depth_only += 1
         else:
             pending.append(f)
     rep.frames_detected = len(detected)
