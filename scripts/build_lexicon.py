@@ -66,6 +66,9 @@ is spoken to):
   that occurs in lower case in its sense-tagged corpus (``cntlist``; "LA" the state does not make
   "la" English); they mark an instruction as not English (``capnav.retrieval.query`` says when).
 
+- ``persons``: nouns whose most frequent sense is a person (noun.person), with their plurals, so
+  that "where can the kids sit" is read as an activity of people, not as where things are kept.
+
 - ``labels``: surface form -> detector class, for the classes a closed-set detector gives that are
   not CapNav categories (``LABEL_ROOTS``: COCO's cup, bottle, book, laptop, cell phone, ...), so
   that every indoor class is reachable by its everyday names ("mug", "rucksack", "mobile phone",
@@ -174,6 +177,7 @@ def build(wordnet: Path) -> dict[str, Any]:
         out["sizes"] = _sizes(wn, (wordnet / "adj.exc").read_text().splitlines())
         out["growth"] = _growth(wn, out["forms"])
         out["labels"] = _labels(wn, out["forms"])
+        out["persons"] = _persons(wn, (wordnet / "noun.exc").read_text().splitlines())
         out["forms"] = dict(sorted(out["forms"].items()))
         return out
 
@@ -453,6 +457,28 @@ def _not_typos(wn: Any, forms: dict[str, str]) -> list[str]:
             if any(OSA.distance(form, t) <= typo_distance(form) for t in close) and _seen(wn, lemma):
                 out.add(form)
     return sorted(out)
+
+
+def _persons(wn: Any, exceptions: list[str]) -> list[str]:
+    """Nouns whose most frequent sense is a person (lexicographer file noun.person) and that occur
+    in lower case in the sense-tagged corpus, with their plurals (regular ones and WordNet's
+    exceptions, ``noun.exc``: children, men): "where can the kids sit" asks where people sit, not
+    where things are kept."""
+    out: set[str] = set()
+    for lemma in wn.all_lemma_names("n"):
+        if lemma != lemma.lower() or not lemma.isalpha():
+            continue
+        senses = [x for x in wn.synsets(lemma, "n") if any(lem.name() == lemma for lem in x.lemmas())]
+        if senses and senses[0].lexname() == "noun.person" and _seen(wn, lemma):
+            out.add(lemma)
+    plural = {w + ("es" if w.endswith(("s", "x", "ch", "sh")) else "s") for w in out if not w.endswith("y")}
+    plural |= {w[:-1] + "ies" for w in out if w.endswith("y") and w[-2:-1] not in "aeiou"}
+    plural |= {w + "s" for w in out if w.endswith("y") and w[-2:-1] in "aeiou"}
+    for line in exceptions:
+        infl, *bases = line.split()
+        if infl.isalpha() and any(b in out for b in bases):
+            plural.add(infl)
+    return sorted(out | plural)
 
 
 def _seen(wn: Any, word: str) -> bool:

@@ -44,6 +44,8 @@ class Lexicon:
     #: a surface form -> the detector class it names, for the detector's classes that are not
     #: categories ("mug" -> "cup", "mobile phone" -> "cell phone"; WordNet's, see build_lexicon)
     labels: dict[str, str] = field(default_factory=dict)
+    #: nouns that name a person, with plurals ("kids", "guests": noun.person in WordNet)
+    persons: frozenset[str] = frozenset()
     load_seconds: float = 0.0
 
     def category_alternatives(self, category: str, form: str | None = None) -> dict[str, float]:
@@ -77,7 +79,8 @@ def load_lexicon() -> Lexicon:
                   glosses={k: tuple(v) for k, v in raw.get("glosses", {}).items()},
                   foreign=frozenset(raw.get("foreign", [])), english=frozenset(raw.get("english", [])),
                   not_typos=frozenset(raw.get("not_typos", [])), sizes=dict(raw.get("sizes", {})),
-                  growth=dict(raw.get("growth", {})), labels=dict(raw.get("labels", {})))
+                  growth=dict(raw.get("growth", {})), labels=dict(raw.get("labels", {})),
+                  persons=frozenset(raw.get("persons", [])))
     object.__setattr__(lex, "load_seconds", time.perf_counter() - t0)
     return lex
 

@@ -109,11 +109,13 @@ def normalise_activity(activity: str) -> str:
 def find_activity(text: str) -> str | None:
     """The activity of a purpose request, lower case, or None when the text names none."""
     low = text.lower().strip().rstrip("?.!")
+    persons = load_lexicon().persons
     for pat in _KEPT:
         m = pat.search(low)
         if m:
             obj = _TAIL.sub("", m.group("obj")).strip(" ,?.!")
-            if obj and obj.split()[-1] not in _PLACEHOLDERS:
+            # "where can the kids sit": people doing something, not a thing kept somewhere
+            if obj and obj.split()[-1] not in _PLACEHOLDERS and obj.split()[-1] not in persons:
                 return f"keep {obj}"
     for pat in _PURPOSE:
         m = pat.search(low)

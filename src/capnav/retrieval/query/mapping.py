@@ -212,6 +212,34 @@ def _negations(q: ParsedQuery, head: str) -> str:
 
 
 _FROM_ROBOT = "the robot"
+_DETERMINERS = {"the", "a", "an", "my", "our", "your", "his", "her", "their", "this", "that", "these", "those", "some"}
+
+
+def _verb_only(before: str) -> bool:
+    """Whether the words before a relation are a verb of going and nothing that names a target
+    ("swing", "pop", "could you nip"): at most two words besides the request's fillers, no
+    determiner (a noun phrase has one: "the piano by the sofa"), no object name."""
+    words = [w for w in before.split() if w not in _FILLER or w in _DETERMINERS]
+    if not words:
+        return True  # "go by the desk", "stop by the sofa"
+    if len(words) > 2 or any(w in _DETERMINERS or w in _GENERIC for w in words):
+        return False
+    cat, _, _ = _find_category(words)
+    return cat is None and find_activity(before) is None
+
+
+def _attributes_outside(q: ParsedQuery, head: str, activity: str) -> None:
+    """A request by purpose describes the furniture outside its activity: "where can I chill a
+    bottle of wine" asks for no wine-coloured fridge, "somewhere to hang my blue coat" for no blue
+    wardrobe. The attributes are read again from the words around the activity."""
+    k = head.find(activity)
+    if k < 0:
+        return
+    words = (head[:k] + " " + head[k + len(activity):]).split()
+    q.colors = _colors(words)
+    q.shapes = list(dict.fromkeys(_SHAPES[w] for w in words if w in _SHAPES))
+    q.materials = [w for w in words if w in _MATERIALS]
+    q.size_word = _size_word(words)
 
 
 def _count(q: ParsedQuery, head: str) -> str:
@@ -297,6 +325,11 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
             if m and m.start() > 0:
                 anchor_words = m.group(1).split()
                 cat, _, _ = _find_category(anchor_words)
+                if cat is not None and _verb_only(head[:m.start()]):
+                    # "swing by the fridge", "pop by the stove": a verb of going with its
+                    # preposition, no object before it: the landmark is the goal.
+                    head = head[:m.start()] + " " + m.group(1)
+                    break
                 if cat is not None:
                     q.relation = "next to" if rel in ("besides", "beside", "by", "close to", "alongside") else rel
                     q.anchor_category = cat
@@ -349,6 +382,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
         activity = find_activity(head) if other is None else None
         if activity is not None:
             q.purpose = activity
+            _attributes_outside(q, head, activity)
             if embedder is not None:
                 # The retriever embeds the instruction next: one batch for both.
                 best, alts = purpose_categories(match_purpose(activity, embedder, along=(q.text,)))

