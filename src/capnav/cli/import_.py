@@ -14,13 +14,17 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from capnav.cli.options import finite_float
+
 if TYPE_CHECKING:
     from capnav.io.importer import Recording
 
 # Options both commands take: declared once.
 Out = Annotated[Path, typer.Option("-o", "--out", help="dataset folder to create")]
-MaxDt = Annotated[float, typer.Option("--max-dt", help="max colour-depth time difference (s)")]
-MaxPoseGap = Annotated[float, typer.Option("--max-pose-gap", help="max gap between the pose stamps around a frame (s)")]
+MaxDt = Annotated[float, typer.Option("--max-dt", parser=finite_float(0.0),
+                                      help="max colour-depth time difference (s)")]
+MaxPoseGap = Annotated[float, typer.Option("--max-pose-gap", parser=finite_float(0.0),
+                                           help="max gap between the pose stamps around a frame (s)")]
 Stride = Annotated[int, typer.Option("--stride", min=1, help="keep every k-th associated frame")]
 MaxFrames = Annotated[int | None, typer.Option("--max-frames", min=1, help="keep only the first N selected frames")]
 Up = Annotated[str, typer.Option("--up", help="'auto' finds up from the floor and the cameras (refuses when unsure); "
@@ -29,7 +33,8 @@ Up = Annotated[str, typer.Option("--up", help="'auto' finds up from the floor an
 Overwrite = Annotated[bool, typer.Option("--overwrite", help="replace an existing dataset folder")]
 Progress = Annotated[bool, typer.Option(help="show progress")]
 Intrinsics = Annotated[str | None, typer.Option("--intrinsics", help="intrinsics file (default: the layout's own)")]
-DepthScale = Annotated[float | None, typer.Option("--depth-scale", help="depth PNG units per metre (default: the "
+DepthScale = Annotated[float | None, typer.Option("--depth-scale", parser=finite_float(1.0),
+                                                  help="depth PNG units per metre (default: the "
                                                                         "layout's: 5000 TUM, 1000 the others)")]
 
 
@@ -85,7 +90,8 @@ def register(app: typer.Typer) -> None:
         src: Annotated[Path, typer.Argument(help="folder with image/ (or color/), depth/, trajectory.log")],
         out: Out,
         intrinsics: Intrinsics = None, depth_scale: DepthScale = None,
-        fps: float = typer.Option(30.0, "--fps", help="frame rate (the layout has no timestamps)"),
+        fps: float = typer.Option(30.0, "--fps", parser=finite_float(0.01),
+                                  help="frame rate (the layout has no timestamps)"),
         trajectory: Path | None = typer.Option(None, "--trajectory", help="the trajectory log, if not SRC/*.log"),
         stride: Stride = 1, max_frames: MaxFrames = None, up: Up = "auto", overwrite: Overwrite = False,
         progress: Progress = True,
@@ -150,7 +156,8 @@ def register(app: typer.Typer) -> None:
         intrinsics: str | None = typer.Option(None, "--intrinsics",
                                               help="fr1 | fr2 | fr3 | JSON file {fx, fy, cx, cy[, width, height]} "
                                                    "(default: from a folder name like ..._freiburg2_...)"),
-        depth_scale: float = typer.Option(5000.0, "--depth-scale", help="depth PNG units per metre"),
+        depth_scale: float = typer.Option(5000.0, "--depth-scale", parser=finite_float(1.0),
+                                          help="depth PNG units per metre"),
         max_dt: MaxDt = 0.02, max_pose_gap: MaxPoseGap = 0.5, stride: Stride = 1, max_frames: MaxFrames = None,
         up: Up = "auto", overwrite: Overwrite = False, progress: Progress = True,
     ) -> None:

@@ -11,6 +11,8 @@ from typing import Annotated
 
 import typer
 
+from capnav.cli.options import finite_float
+
 TOKEN_ENV = "CAPNAV_SERVE_TOKEN"
 
 
@@ -39,10 +41,14 @@ def register(app: typer.Typer) -> None:
         pool: Annotated[str, typer.Option(help="processes (a GIL each: asks run side by side and /healthz never "
                                                "waits behind them) or threads (less memory)")] = "processes",
         queue: Annotated[int, typer.Option(min=0, help="asks that may wait for a worker (more: 503)")] = 64,
-        time_limit: Annotated[float, typer.Option(min=0.01, help="seconds an ask may take (else 503)")] = 10.0,
-        body_timeout: Annotated[float, typer.Option(min=0.01, help="seconds to receive a request body")] = 10.0,
-        header_timeout: Annotated[float, typer.Option(min=0.01, help="seconds to receive request headers")] = 10.0,
-        rate: Annotated[float, typer.Option(min=0.0, help="requests per second per client (0: no limit)")] = 50.0,
+        time_limit: Annotated[float, typer.Option(parser=finite_float(0.01),
+                                                  help="seconds an ask may take (else 503)")] = 10.0,
+        body_timeout: Annotated[float, typer.Option(parser=finite_float(0.01),
+                                                    help="seconds to receive a request body")] = 10.0,
+        header_timeout: Annotated[float, typer.Option(parser=finite_float(0.01),
+                                                      help="seconds to receive request headers")] = 10.0,
+        rate: Annotated[float, typer.Option(parser=finite_float(0.0),
+                                            help="requests per second per client (0: no limit)")] = 50.0,
         burst: Annotated[int, typer.Option(min=1, help="requests a client may send at once")] = 100,
         max_body: Annotated[int, typer.Option(min=256, help="largest request body in bytes")] = 16_384,
         access_log: Annotated[bool, typer.Option("--access-log", help="one log line per request (method, path, "

@@ -10,6 +10,7 @@ from urllib.parse import urlparse
 
 import typer
 
+from capnav.cli.options import finite_float
 from capnav.core.errors import InputError, OutputError
 
 
@@ -56,6 +57,7 @@ def register(app: typer.Typer) -> None:
         max_voxels: Annotated[int, typer.Option(min=1, help="voxels logged at most (a seeded subsample beyond)")
                               ] = 300_000,
         max_z: Annotated[float | None, typer.Option(
+            parser=finite_float(),
             help="leave out voxels above this height (m), e.g. 2.0 to drop the ceiling and look in from above")
                          ] = None,
     ) -> None:
