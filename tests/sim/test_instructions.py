@@ -79,3 +79,32 @@ def test_describe_callable_for_episodes(manifest):
     assert "category" in kinds and len(kinds) >= 3
     xy = gen.robot_position(rng)
     assert all(len(gen.describe(o.id, xy, rng)) == 2 for o in manifest.objects[:5])
+
+
+def test_closest_holds_along_the_floor_when_the_generator_knows_it() -> None:
+    """Through a wall the straight-line nearest plant can be the longer walk. Given the true floor,
+    every "closest" instruction is closest by a clear margin both ways, and some that held only in a
+    straight line are no longer made (so the instruction means one object whatever the reader has
+    in mind)."""
+    from capnav.core.grid import FREE
+    from capnav.sim.geodesic import walker
+    from capnav.sim.navgrid import NavGrid
+
+    apt = generate_apartment(3, SimConfig())
+    nav = NavGrid(apt.obstacles(), apt.bounds, SimConfig().agent.radius, 0.1).navigable()
+    walk = walker(nav.spec, nav.cells == FREE)
+    plain, floor = InstructionGenerator(apt.manifest), InstructionGenerator(apt.manifest, walk=walk)
+    rng = np.random.default_rng(0)
+    held_both = held_straight_only = 0
+    for _ in range(40):
+        xy = plain.robot_position(rng)
+        for o in apt.manifest.objects:
+            if not plain.closest_ok(o, xy):
+                continue
+            if floor.closest_ok(o, xy):
+                held_both += 1
+                w = walk(xy, o)
+                assert all(walk(xy, p) >= w + 1.0 for p in floor.peers(o))
+            else:
+                held_straight_only += 1
+    assert held_both > 0 and held_straight_only > 0

@@ -7,7 +7,7 @@ import pytest
 
 from capnav.core.footprint import footprint_distance
 from capnav.core.grid import GridSpec
-from capnav.eval.geodesic import distance_field
+from capnav.sim.geodesic import distance_field
 from capnav.sim.success import distance_to_instances, is_success
 
 SQUARE = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]])

@@ -31,6 +31,8 @@ from capnav.pipeline import PipelineConfig, SimScene, open_sim_scene
 from capnav.pipeline.drive import run_instruction
 from capnav.planning import PlannerConfig
 from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
+from capnav.sim.geodesic import walker
+from capnav.sim.instructions import Walk, generate_instructions
 from capnav.sim.navgrid import start_cells
 from capnav.sim.success import SUCCESS_RADIUS_M, distance_to_instances
 
@@ -94,16 +96,14 @@ def _off_facing_deg(pose: tuple[float, float, float], footprint: NDArray[np.floa
     return 0.0 if lo <= h <= hi else float(np.degrees(min(abs(wrap(h - lo)), abs(wrap(h - hi)))))
 
 
-def _next_instruction(cfg: DemoConfig, k: int, sim: Any, robot_xy: tuple[float, float]
+def _next_instruction(cfg: DemoConfig, k: int, sim: Any, robot_xy: tuple[float, float], walk: Walk
                       ) -> tuple[str, str, list[int]] | None:
     """The k-th instruction (text, kind, target ids): the user's, or one generated for the k-th kind
     from where the robot stands now (so that "closest" means closest to the robot when it is asked)."""
     if cfg.instructions:
         return (cfg.instructions[k], "user", [])
-    from capnav.sim.instructions import generate_instructions
-
     made = generate_instructions(sim.manifest, per_kind=1, seed=cfg.seed * 1000 + k, kinds=(cfg.kinds[k],),
-                                 robot_xy=robot_xy)
+                                 robot_xy=robot_xy, walk=walk)
     return (made[0].text, made[0].kind, list(made[0].targets)) if made else None
 
 
@@ -124,6 +124,7 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
                          PlannerConfig().inflation + nav_truth.spec.resolution)
     footprints = {o.id: np.asarray(o.footprint, dtype=np.float64) for o in sim.manifest.objects}
     rooms = [np.asarray(r.polygon, dtype=np.float64) for r in sim.manifest.rooms]
+    walk = walker(nav_truth.spec, nav_truth.cells == FREE)  # "closest" along the true floor
     con.print(f"     {len(sim.manifest.rooms)} rooms, {len(sim.manifest.objects)} objects "
               f"({time.perf_counter() - t0:.1f} s)")
     from capnav.viz.scene import draw_scene
@@ -153,7 +154,7 @@ def run_demo(cfg: DemoConfig, console: Console | None = None) -> DemoResult:
     pcfg_plan = PlannerConfig()
     for k in range(n):
         x, y, _ = agent.pose
-        nxt = _next_instruction(cfg, k, sim, (float(x), float(y)))
+        nxt = _next_instruction(cfg, k, sim, (float(x), float(y)), walk)
         if nxt is None:
             con.print(f"     (this apartment allows no {cfg.kinds[k]!r} instruction; skipped)")
             continue

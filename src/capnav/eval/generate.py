@@ -19,7 +19,7 @@ from capnav.core.errors import DatasetError, InputError
 from capnav.core.footprint import footprint_distance
 from capnav.core.grid import GridSpec
 from capnav.eval.episodes import Episode, StartPose, Subgoal
-from capnav.eval.geodesic import DistanceField, distance_field
+from capnav.sim.geodesic import DistanceField, distance_field
 from capnav.sim.sightline import SightGrid
 from capnav.sim.success import SUCCESS_RADIUS_M
 

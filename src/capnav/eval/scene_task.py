@@ -86,7 +86,8 @@ def generate_scene_episodes(assets: SceneAssets, config: EvalConfig, protocol: s
         return label_episodes(assets.truth, rng, config.episode_config())
     from capnav.sim.instructions import InstructionGenerator
 
-    describe = InstructionGenerator(assets.sim.manifest).describe
+    truth = assets.truth
+    describe = InstructionGenerator(assets.sim.manifest, walk=lambda xy, o: truth.field([o.id]).at(xy)).describe
     return description_episodes(assets.truth, describe, rng, config.episode_config())
 
 

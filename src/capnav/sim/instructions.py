@@ -20,7 +20,7 @@ only cue.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -67,6 +67,10 @@ class InstructionConfig:
     oov_absent_prob: float = 0.3
 
 
+#: ``walk(robot_xy, instance) -> metres`` along the true floor from the robot to within reach of it.
+Walk = Callable[[tuple[float, float], ObjectInstance], float]
+
+
 @dataclass
 class Instruction:
     text: str
@@ -98,9 +102,11 @@ def footprint_gap(a: ObjectInstance, b: ObjectInstance) -> float:
 class InstructionGenerator:
     """Describe instances of one scene; every public method takes the caller's ``rng``."""
 
-    def __init__(self, manifest: SceneManifest, config: InstructionConfig | None = None) -> None:
+    def __init__(self, manifest: SceneManifest, config: InstructionConfig | None = None,
+                 walk: Walk | None = None) -> None:
         self.m = manifest
         self.cfg = config or InstructionConfig()
+        self.walk = walk
         self.rooms = {r.id: r.name for r in manifest.rooms}
         self.by_id = {o.id: o for o in manifest.objects}
         self.lab = {o.id: srgb_to_lab(np.array(o.color_rgb, dtype=np.float64)) for o in manifest.objects}
@@ -178,12 +184,21 @@ class InstructionGenerator:
         return room
 
     def closest_ok(self, o: ObjectInstance, robot_xy: tuple[float, float]) -> bool:
+        """``o`` is the closest of its kind by a clear margin: in a straight line and, when the
+        generator knows the floor (``walk``), along it too, so the instruction means one object
+        whichever distance the reader has in mind (through a wall, the nearer plant may be the
+        farther walk)."""
         peers = self.peers(o)
         if not peers:
             return False
         r = np.asarray(robot_xy)
         d = float(np.linalg.norm(np.asarray(o.center[:2]) - r))
-        return all(float(np.linalg.norm(np.asarray(p.center[:2]) - r)) >= d + self.cfg.closest_margin for p in peers)
+        if not all(float(np.linalg.norm(np.asarray(p.center[:2]) - r)) >= d + self.cfg.closest_margin for p in peers):
+            return False
+        if self.walk is None:
+            return True
+        w = self.walk(robot_xy, o)
+        return bool(np.isfinite(w)) and all(self.walk(robot_xy, p) >= w + self.cfg.closest_margin for p in peers)
 
     # -- one description per kind --------------------------------------------------------------
     def describe_as(self, o: ObjectInstance, kind: str, rng: np.random.Generator,
@@ -292,13 +307,15 @@ class InstructionGenerator:
 
 def generate_instructions(manifest: SceneManifest, per_kind: int = 10, seed: int = 0,
                           kinds: Sequence[str] = KINDS, config: InstructionConfig | None = None,
-                          robot_xy: tuple[float, float] | None = None) -> list[Instruction]:
+                          robot_xy: tuple[float, float] | None = None, walk: Walk | None = None
+                          ) -> list[Instruction]:
     """Up to ``per_kind`` instructions of each kind (fewer when the scene allows fewer), seeded.
-    "closest" instructions use ``robot_xy`` when given, else random free positions in rooms."""
+    "closest" instructions use ``robot_xy`` when given, else random free positions in rooms, and
+    hold by walking distance too when ``walk`` is given."""
     for k in kinds:
         if k not in KINDS:
             raise InputError(f"unknown instruction kind {k!r}; kinds: {', '.join(KINDS)}")
-    gen = InstructionGenerator(manifest, config)
+    gen = InstructionGenerator(manifest, config, walk)
     rng = np.random.default_rng(seed)
     out: list[Instruction] = []
     objs = list(manifest.objects)

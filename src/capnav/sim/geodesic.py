@@ -8,8 +8,9 @@ field is computed once per (apartment, goal) and looked up per subgoal.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -103,3 +104,18 @@ def distance_field(spec: GridSpec, navigable: NDArray[np.bool_], footprints: Seq
         dist[nav] = d
     return DistanceField(spec, dist, nav)
 
+
+
+def walker(spec: GridSpec, navigable: NDArray[np.bool_], radius: float = SUCCESS_RADIUS_M
+           ) -> Callable[[tuple[float, float], Any], float]:
+    """``walk(xy, instance)``: metres along the navigable cells from ``xy`` to within ``radius`` of
+    the instance's footprint (one distance field per instance, kept), for instructions that say
+    "closest" the way a walker means it."""
+    fields: dict[int, DistanceField] = {}
+
+    def walk(xy: tuple[float, float], instance: Any) -> float:
+        if instance.id not in fields:
+            fields[instance.id] = distance_field(spec, navigable, [np.asarray(instance.footprint)], radius)
+        return fields[instance.id].at(xy)
+
+    return walk
