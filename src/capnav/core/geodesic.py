@@ -30,18 +30,19 @@ def grid_geodesic(domain: NDArray[np.bool_], seeds: NDArray[np.int64], limit: fl
     rows, cols = domain.shape
     w = cols + 2  # a border of unwalkable cells: no bounds checks in the loop
     n = (rows + 2) * w
-    dom = np.zeros(n, np.bool_)
+    # One byte per cell: 0 not walkable (or the border), 1 walkable, 2 expanded (final).
+    state = np.zeros(n, np.uint8)
     for r in range(rows):
         for c in range(cols):
-            dom[(r + 1) * w + c + 1] = domain[r, c]
+            if domain[r, c]:
+                state[(r + 1) * w + c + 1] = 1
     off = np.empty(8, np.int64)
     for m in range(8):
         off[m] = _DR[m] * w + _DC[m]
     dist = np.full(n, np.inf)
-    done = np.zeros(n, np.bool_)
     # Three buckets suffice: a cell expanded from bucket k lands in k + 1 or k + 2 (steps < 2).
     cap = 2 * rows * cols + seeds.shape[0] + 1
-    buckets = np.empty((3, cap), np.int64)
+    buckets = np.empty((3, cap), np.int32)
     fill = np.zeros(3, np.int64)
     for i in range(seeds.shape[0]):
         u = (seeds[i, 0] + 1) * w + seeds[i, 1] + 1
@@ -57,15 +58,15 @@ def grid_geodesic(domain: NDArray[np.bool_], seeds: NDArray[np.int64], limit: fl
         while j < fill[b]:
             u = buckets[b, j]
             j += 1
-            if done[u]:
+            if state[u] == 2:
                 continue
-            done[u] = True
+            state[u] = 2
             du = dist[u]
             if du > limit:
                 continue
             for m in range(8):
                 v = u + off[m]
-                if not dom[v] or done[v]:
+                if state[v] != 1:
                     continue
                 nd = du + _STEP[m]
                 dv = dist[v]
