@@ -105,7 +105,7 @@ def test_a_purpose_whose_best_category_is_absent_goes_to_what_else_serves_it(ret
 
 
 def test_the_x_in_a_room_where_no_x_stands_is_not_found(retriever):
-    res = retriever.query("take me to the bookshelf in the kitchen")
+    res = retriever.query("show me a bookshelf in our kitchen")
     assert not res.found and "no bookshelf stands in the kitchen" in res.reason and "living room" in res.reason
     assert retriever.query("the bookshelf in the lounge").chosen.id == 16
 
@@ -146,10 +146,10 @@ def test_landmark_relative_closest_resolves_the_landmark_first(retriever):
               proximity_to_anchor=True, anchor_category="refrigerator", anchor_phrase="fridge")
     assert res.chosen.id == 4 and res.chosen.label == "stool"
     # Two lamps: the landmark is the red one, so the armchair beside it.
-    res = ask(retriever, "the armchair closest to the red lamp", proximity="closest", proximity_to_anchor=True,
+    res = ask(retriever, "which armchair stands closest to the red lamp", proximity="closest", proximity_to_anchor=True,
               anchor_category="lamp", anchor_phrase="red lamp", colors=[])
     assert res.chosen.id == 14
-    res = ask(retriever, "the armchair closest to the yellow lamp", proximity="closest", proximity_to_anchor=True,
+    res = ask(retriever, "which armchair is nearest the yellow lamp", proximity="closest", proximity_to_anchor=True,
               anchor_category="lamp", anchor_phrase="yellow lamp", colors=[])
     assert res.chosen.id == 11
 
@@ -183,9 +183,9 @@ def test_the_room_with_a_landmark_is_the_landmarks_region(retriever):
 
 def test_an_alternative_does_not_serve_a_bare_name_whose_category_is_absent(retriever):
     # No dining table and no ottoman in the flat: the coffee table or a stool must not stand in.
-    assert not ask(retriever, "the dining table", category="table", category_alternatives={"coffee table": 0.8}).found
+    assert not ask(retriever, "head for the dining table please", category="table", category_alternatives={"coffee table": 0.8}).found
     assert not ask(retriever, "take me to the pouf", category="ottoman", category_alternatives={"stool": 0.5}).found
-    assert not ask(retriever, "the round table", category="table", shapes=["round"],
+    assert not ask(retriever, "go to the round table", category="table", shapes=["round"],
                    category_alternatives={"coffee table": 0.8}).found
     # With an observed attribute the alternative may serve.
     res = ask(retriever, "the brown table", category="table", category_alternatives={"coffee table": 0.8})

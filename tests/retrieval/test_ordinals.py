@@ -108,7 +108,7 @@ def test_ordinals_said_as_an_adverb_a_number_or_a_skip(text, n):
 @pytest.mark.parametrize("text", [
     "I want to sit down for a second on the stool",
     "give me a second, then the desk",
-    "the stool next to the fridge",
+    "the stool beside the cooker",
 ])
 def test_words_that_are_no_ordinal(text):
     assert (parse_instruction(text).ordinal or 1) == 1

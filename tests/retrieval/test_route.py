@@ -42,7 +42,7 @@ def retriever() -> Retriever:
     ("walking from the living room into the bedroom, the chair on your left", 6),
     ("as you come into the bedroom from the lounge, which chair is on the right-hand side? go there", 7),
     ("the first chair you get to when you walk into the bedroom from the sitting room", 6),
-    ("the second chair from the door to the living room", 7),
+    ("counting from the doorway to the living room, the second chair", 7),
 ])
 def test_route_order_and_side_come_from_the_map(retriever: Retriever, text: str, oid: int) -> None:
     res = retriever.query(text)

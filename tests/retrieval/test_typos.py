@@ -15,7 +15,7 @@ from capnav.retrieval.query.tokens import typo_distance
     ("the succlent by the tv", "plant", {"anchor_category": "tv"}),  # a WordNet form, one letter dropped
     ("the ottmoan in the lounge", "ottoman", {"room": "living room"}),  # two letters swapped
     ("the wardrboe in the bdroom", "wardrobe", {"room": "bedroom"}),
-    ("the cupbaord in the kitchen", "cabinet", {"room": "kitchen"}),
+    ("the cupbaord in the bathroom", "cabinet", {"room": "bathroom"}),
     ("the frigde nex to the stove", "refrigerator", {"anchor_category": "stove", "relation": "next to"}),
     ("the gren lamp", "lamp", {"colors": ["green"]}),
     ("the wite armchiar", "armchair", {"colors": ["white"]}),

@@ -1,6 +1,6 @@
 """Shape words from an object's fused points: its outline and a plant's growth; None when unsure.
 
-Why: people single objects out by shape ("the round table", "the L-shaped sofa", "the leafy
+Why: people single objects out by shape ("the round ottoman", "the L-shaped couch", "the leafy
 plant", "the cactus"), and the map holds each object's points. Every rule here reads only those points
 (world frame, z up); its thresholds are measured by ``benchmarks/measure_evidence.py`` against
 the simulator's shape variants and listed in docs/benchmarks.md. A word is said only when its

@@ -1,4 +1,4 @@
-"""Requests by purpose ("somewhere to sit", "where can I wash my hands?") -> candidate categories.
+"""Requests by purpose ("somewhere to sit", "where can I brush my teeth?") -> candidate categories.
 
 Why: people often name what they want to do, not the object. The activity is compared, with the
 text embedder, to what WordNet says each category is for (the lexicon's glosses: a bed "provides a
@@ -93,7 +93,7 @@ class PurposeConfig:
 
 @dataclass(frozen=True)
 class PurposeMatch:
-    activity: str  # "wash my hands"
+    activity: str  # "brush my teeth"
     scores: dict[str, float]  # category -> mean cosine of the activity to its top_k glosses, best first
 
 

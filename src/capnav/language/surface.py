@@ -1,7 +1,7 @@
 """Surface appearance from an object's view pixels: a woven weave or a smooth surface, grainy or
 plain, else nothing.
 
-Why: a person says "the fabric sofa" or "the leather armchair"; the map can only say what its
+Why: a person says "the fabric sofa" or "the leather ottoman"; the map can only say what its
 pixels show. A weave repeats every texel or two, so it puts more energy in the finest band of
 lightness detail (Gaussian scales 0-0.7 px) than in the next one (0.7-1.5 px); grain, mottle,
 veins and flat paint do not. Velvet's pile hides its weave, so in pixels it is smooth.

@@ -1,8 +1,8 @@
 """Geometry of the relations that need more than the gap between two boxes: "between" two
 landmarks, "at the end of" a long one, and distances along the floor.
 
-Why: "the table between the sofa and the armchair" is the object on the line joining the two,
-not the one nearest either; "the chair at the end of the table" sits beyond a short edge of the
+Why: "the lamp between the bed and the wardrobe" is the object on the line joining the two,
+not the one nearest either; "the stool at the end of the counter" sits beyond a short edge of the
 table, not along its long side. Both are measured on what the map observed: object centres and
 the footprint (convex hull of the fused points in x, y). "The nearest plant to me" is the one the
 robot walks to first, not the one nearest through a wall: :class:`FloorDistances` measures along

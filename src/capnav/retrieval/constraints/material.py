@@ -39,7 +39,7 @@ class Material(AttributeConstraint):
             return Evidence(self.kind, CONTRADICTED, 0.0, why)
         if weight < 1.0 and mat < 1.0 and any(map(material_shows, q.materials)):
             # Another category stands in for the named one only when its pixels show the spoken
-            # material: "the leather sofa" is not a chair of unknown surface.
+            # material: "the leather stool" is not a chair of unknown surface.
             return Evidence(self.kind, CONTRADICTED, 0.0,
                             f"its pixels do not show {'/'.join(q.materials)} ({why})")
         return Evidence(self.kind, SUPPORTED if mat >= 1.0 else UNOBSERVED, mat, why, {"material": round(mat, 3)})

@@ -1,4 +1,4 @@
-"""A negation ("not the white one", "the bookshelf that isn't grey"): the candidates it names
+"""A negation ("not the white one", "the wardrobe that isn't white"): the candidates it names
 leave the pool; when it leaves no other one of the named category, "not found"."""
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ class Negation(RankingConstraint):
         had_named = bool((st.weights[st.pool] >= 1.0).any())
         st.keep(np.array([int(i) not in neg for i in st.pool], dtype=bool))
         if not len(st.pool) or (had_named and not (st.weights[st.pool] >= 1.0).any()):
-            # "not the white washer, the other one" presumes another of that category: an
+            # "not the black stove, the other one" presumes another of that category: an
             # alternative category ("a fridge can serve as a washer") is no "other one".
             st.refuse(self.kind, f"every {q.category or 'candidate'} matches what the instruction excludes "
                                  f"({'; '.join(q.negations)})")
@@ -45,7 +45,7 @@ class Negation(RankingConstraint):
         A negated colour is read as a definite description among the candidates: it names the
         ones that fit it best (agreement at least ``color_reject``, and at least
         ``negation_contrast`` of the best fit among the named category's candidates), not every
-        candidate that is somewhat that colour; so "not the yellow lamp, the other one" excludes
+        candidate that is somewhat that colour; so "not the red armchair, the other one" excludes
         the mustard lamp although its agreement is below ``color_match``, and "not the white
         washing machine" keeps the light grey one when a white one stands beside it."""
         r, q, pool, weights = st.r, st.q, st.pool, st.weights
@@ -58,7 +58,7 @@ class Negation(RankingConstraint):
             except InputError:
                 continue
             if nq.category is not None and nq.category != q.category and not nq.colors and not nq.room:
-                continue  # "not the one at the end of the table": a relation this reader does not judge
+                continue  # "not the one at the end of the counter": a relation this reader does not judge
             fits = np.ones(len(pool), dtype=bool)
             judged = False
             if nq.category is not None and nq.category == q.category:
@@ -78,7 +78,7 @@ class Negation(RankingConstraint):
                                   for i in pool])
                 judged = True
             if nq.materials:
-                # "the sofa that isn't leather" presumes a leather one: those whose pixels show it
+                # "the ottoman that isn't velvet" presumes a velvet one: those whose pixels show it
                 # (evidence supported) are excluded; when none shows it but some show a surface
                 # against it, those are the ones that are not, and the unobserved ones go instead.
                 mat = [r.judge.material(nq, r.objects[int(i)])[0] for i in pool]

@@ -1,5 +1,5 @@
-"""A landmark relation: "next to the cactus", "between the sofa and the armchair", "at the end of
-the table", "in the room with the pink dresser", "the chair closest to the table". The landmark is
+"""A landmark relation: "beside the fern", "between the bed and the wardrobe", "at the end of
+the counter", "in the room with the green wardrobe", "the stool nearest the stove". The landmark is
 resolved first (its colour, room or growth form picks the instance), then the candidates are
 ordered by the relation's geometry in quarter-metre bins, so attributes break only near-ties."""
 
@@ -39,7 +39,7 @@ def landmarks(st: RankState, second: bool = False) -> NDArray[np.intp]:
         inroom = anchors[[r.scene.rooms[k] == aq.room for k in anchors]]
         anchors = inroom if len(inroom) else anchors
     if aq.shapes and len(anchors) > 1:
-        # "next to the cactus": the plants whose points show the cactus's growth form.
+        # "beside the cactus": the plants whose points show the cactus's growth form.
         agree = np.array([r.judge.shape(aq, r.objects[k])[0] or 0.0 for k in anchors])
         if agree.max() > 0:
             anchors = anchors[agree >= agree.max()]
@@ -71,7 +71,7 @@ class Relation(RankingConstraint):
         st.values["gap to landmark (m)"] = gap
         regions = {int(r.scene.region[k]) for k in anchors} - {-1}
         if q.relation == ROOM_WITH and regions:
-            # "the bed in the room with the pink dresser": the landmark's room region.
+            # "the lamp in the room with the green wardrobe": the landmark's room region.
             same_room = np.array([int(r.scene.region[i]) in regions for i in pool], dtype=np.float64)
             st.group_keys.append(-same_room)
             st.predicate = f"{ROOM_WITH} the {q.anchor_category}"
@@ -79,7 +79,7 @@ class Relation(RankingConstraint):
                 st.refuse(self.kind, f"no {q.category or q.target_phrase} stands in the room with the "
                                      f"{q.anchor_phrase}", override=False)
         elif q.relation == BETWEEN and q.anchor2_category is not None and len(second := landmarks(st, True)):
-            # "the table between the sofa and the armchair": distance to the segment joining
+            # "the lamp between the bed and the wardrobe": distance to the segment joining
             # the two landmarks' centres (the best pair when there are several).
             line = np.array([min((segment_distance(xy[i], xy[a_], xy[b_]) for a_ in anchors for b_ in second
                                   if len({int(i), int(a_), int(b_)}) == 3), default=np.inf) for i in pool])
@@ -88,7 +88,7 @@ class Relation(RankingConstraint):
             st.predicate = f"between the {q.anchor_category} and the {q.anchor2_category}"
         elif q.relation == END_OF and len(long_ := np.array(
                 [k for k in anchors if has_long_axis(r.objects[k].footprint)], dtype=np.intp)):
-            # "the chair at the end of the table": distance to the nearer end of the
+            # "the stool at the end of the counter": distance to the nearer end of the
             # landmark's long axis (a round or square landmark has no end: "next to").
             ends = np.array([min((end_distance(xy[i], r.objects[k].footprint) for k in long_ if k != i),
                                  default=np.inf) for i in pool])
@@ -96,7 +96,7 @@ class Relation(RankingConstraint):
             st.group_keys.append(np.round(ends / BIN_M))
             st.predicate = f"{END_OF} the {q.anchor_category}"
         elif q.proximity_to_anchor and q.proximity is not None:
-            # "the chair closest to the table": distance to the landmark, exactly (along the
+            # "the stool nearest the stove": distance to the landmark, exactly (along the
             # floor when the config says so: one Dijkstra from the landmarks' boxes).
             floor = r.floor_distances()
             walk = floor.from_objects(anchors)[pool] if floor is not None else None

@@ -1,4 +1,4 @@
-"""The room ("the lamp in the study"): inferred from the objects around each candidate, never
+"""The room ("the stool in the study"): inferred from the objects around each candidate, never
 observed, so it orders (the named room, then no inferred room, then the strength of its cues) and
 refuses only where the evidence against it is confident."""
 

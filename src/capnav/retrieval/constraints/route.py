@@ -1,6 +1,6 @@
-"""A route into a room ("the first desk you reach coming into the study from the hall", "the
-lamp on your left as you walk from the kitchen into the lounge", "the second bookshelf from the
-door to the hall"): candidates ordered by how far they stand from the way in, and split by the
+"""A route into a room ("the first armchair you reach coming into the lounge from the kitchen", "the
+plant on your left as you walk from the hall into the bedroom", "the third lamp from the
+door to the landing"): candidates ordered by how far they stand from the way in, and split by the
 side they are on as seen walking through it.
 
 The way in is found in the map, never in the simulator's doors: the free space is cut into room

@@ -1,11 +1,11 @@
 """What an ordinal counts and where the count starts: "the second stool from the fridge", "the
-third bookshelf from the door to the hall", "the plant you reach second", "number three", "skip
+third lamp from the door to the landing", "the plant you reach second", "number three", "skip
 the nearest sofa and take the next one".
 
 Why: an ordinal is said in many ways besides an adjective of the object (an adverb after a verb
 of reaching, "number N", skipping some and taking the next), and it counts from somewhere: a
 landmark object (the count is then the order of distance from it), a door named by the room
-behind it ("the door to the hall", "the hall door", "the kitchen doorway"), or a room one comes
+behind it ("the door to the landing", "the landing door", "the kitchen doorway"), or a room one comes
 from ("walking in from the hall"). A door or a room one comes from is the route's origin
 (``constraints/route.py`` orders from the way in); a landmark is a distance landmark
 (``constraints/relation.py``). The start phrase is taken out of the words the mapping reads, so
@@ -27,7 +27,7 @@ DOORS = {"door", "doorway", "doors", "entrance", "entry", "archway", "opening", 
 #: Verbs and phrases that start a count at something: "starting at", "begin by", "count from".
 _START = re.compile(r"\b(?:(?:start|starting|started|begin|beginning|count|counting|work|working)\s+"
                     r"(?:off\s+)?(?:at|from|by|with|beside|next\s+to)|from)\s+(?:the\s+|a\s+|an\s+|my\s+|your\s+|our\s+)?")
-#: "skip the nearest sofa and go to the next one", "pass the first two and take the one after".
+#: "pass the closest lamp and take the next", "skip the first two and take the one after".
 _SKIP = re.compile(r"\b(?:skip|skipping|pass|passing|ignore|ignoring|miss|missing|bypass|go\s+past|walk\s+past|past)"
                    r"\s+(?:the\s+)?(?:(?P<which>first|nearest|closest)\s+)?(?:(?P<k>one|two|three|four|[1-4])\s+)?")
 _NEXT = re.compile(r"\b(?:the\s+)?(?:next(?!\s+to\b)(?:\s+one)?|one\s+after(?:\s+that)?|following\s+one)\b")
@@ -74,7 +74,7 @@ def _room_ending_at(words: list[str], j: int) -> tuple[str, int] | None:
 
 def door_room(words: list[str]) -> tuple[str | None, str | None, int] | None:
     """(room behind the door, room it belongs to, words used) of a door phrase at the start of
-    ``words``: "hall door", "office hall door" (the office's), "door to the hall", "kitchen
+    ``words``: "hall door", "office hall door" (the office's), "door to the landing", "kitchen
     doorway"; None when ``words`` names no door within its first words."""
     k = next((i for i, w in enumerate(words[:5]) if w in DOORS), None)
     if k is None:

@@ -1,7 +1,7 @@
 """The mapping of a goal's words onto ``ParsedQuery``: the target category (with the other
 categories it may denote), colour / shape / size / material words, a spatial predicate (closest /
 farthest to the robot or to a landmark, biggest / smallest, next to / near / in front of Y, "the
-second closest"), a room ("in the kitchen", "the kitchen stool"), what the target must not be
+second closest"), a room ("in the kitchen", "the office lamp"), what the target must not be
 ("not the white one") and, for requests by purpose ("somewhere to sit"), the categories that serve
 it. The phrase patterns here read one goal whose words the parse (``parse.py``) has already
 chosen; whatever they do not understand still reaches the embedding similarity."""
@@ -78,7 +78,7 @@ def _landmark_proximity(q: ParsedQuery, head: str) -> str:
     return (head[: m.start()] + " " + m.group("mid") + " " + " ".join(anchor_words[span[1]:])).strip()
 
 
-#: Verbs of a landmark clause ("the desk the pink chair is pulled up to", "the table that the lamp
+#: Verbs of a landmark clause ("the table the grey stool is tucked under", "the bed that the lamp
 #: stands beside"): the clause's subject is the landmark, not a description of the target.
 _CLAUSE_VERB = re.compile(r"\b(?:is|are|was|were|sits|sit|stands|stand|rests|lies|has\s+been)\b")
 
@@ -96,7 +96,7 @@ def _landmark(words: list[str]) -> tuple[str, str, list[str]] | None:
 
 
 def _room_with(q: ParsedQuery, head: str) -> str:
-    """"in the room with the pink dresser", "in the bedroom that has the yellow bed": the target
+    """"in the room with the green wardrobe", "in the bedroom that has the grey bed": the target
     stands in the landmark's room (``ROOM_WITH``); a named room type is kept as the room too.
     Returns ``head`` without the clause."""
     m = re.search(rf"\b(?:in|inside|within)\s+{_ARTICLE}(?P<room>{_ROOM_ALT}|room)\s+(?:with|that\s+has|which\s+has"
@@ -118,8 +118,8 @@ _CONTEXT_CLAUSE = re.compile(r"\b(?:while|whilst|when|as|and)\s+(?:i|we|you)\s+(
 
 
 def _purpose_context(q: ParsedQuery, head: str) -> str:
-    """A purpose request with a clause of its own that names an object ("somewhere to put my
-    coffee down while I watch telly"): the object is the setting, not the target; the target is
+    """A purpose request with a clause of its own that names an object ("somewhere to rest my
+    plate while we watch the tv"): the object is the setting, not the target; the target is
     looked for in the room with it (``ROOM_WITH``). Returns ``head`` without the clause."""
     if find_activity(head) is None:
         return head
@@ -135,7 +135,7 @@ def _purpose_context(q: ParsedQuery, head: str) -> str:
 
 
 def _between(q: ParsedQuery, head: str) -> str:
-    """"the table between the green sofa and the purple armchair": two landmarks, each with its
+    """"the lamp between the black bed and the white wardrobe": two landmarks, each with its
     own words. Returns ``head`` without them."""
     m = re.search(rf"\b(?:in\s+)?between\s+{_ARTICLE}(?P<a>.+?)\s+and\s+{_ARTICLE}(?P<b>.+)$", head)
     if not m or m.start() == 0:
@@ -150,7 +150,7 @@ def _between(q: ParsedQuery, head: str) -> str:
 
 
 def _clause_landmark(q: ParsedQuery, head: str) -> str:
-    """"the desk the pink chair is pulled up to", "the table that the green lamp stands beside":
+    """"the table the grey stool is tucked under", "the bed that the green lamp stands beside":
     a second noun phrase after the target, followed by a verb, is a landmark next to the target;
     its words (colours, sizes) are the landmark's. Returns ``head`` without the clause."""
     words = head.split()
@@ -191,7 +191,7 @@ def _split_alternatives(words: list[str]) -> list[list[str]]:
 def _negations(q: ParsedQuery, head: str) -> str:
     """Fill ``q.negations`` with what the target must not be, as short phrases a parse of their own
     reads ("white", "in the bedroom"); returns ``head`` without them. The negated phrase's category
-    still names the target ("not the white washer, the other one")."""
+    still names the target ("not the black stove, the other one")."""
     out = head
     for m in list(_NEGATION.finditer(head))[::-1]:
         words = m.group("neg").split()
@@ -276,12 +276,12 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     norm = " ".join(_fix_keyword_typos(norm.replace("'s", "").split()))
     q = ParsedQuery(text=t)
     head = _negations(q, norm)
-    # "somewhere to put my coffee down while I watch telly": the telly is where, not what.
+    # "somewhere to rest my plate while we watch the tv": the tv is where, not what.
     head = _purpose_context(q, head)
-    # "the bed in the room with the pink dresser", "the wardrobe in the bedroom with the yellow bed".
+    # "the lamp in the room with the green wardrobe", "the dresser in the bedroom with the grey bed".
     head = _room_with(q, head)
     # An ordinal and where it counts from: "the second stool from the fridge", "number two from
-    # the hall door", "skip the nearest sofa and take the next one".
+    # the hall door", "pass the closest lamp and take the next".
     head = _count(q, head)
     # Room: "in the kitchen", "in the living room".
     for phrase in sorted(ROOM_SYNONYMS, key=len, reverse=True):
@@ -312,10 +312,10 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                 break
         head = re.sub(r"\b(?:to|from)\s+(?:me|you|us|here|the robot)\b|\baway\b", " ", head) \
             if q.proximity else head
-    # A landmark clause: "the desk the pink chair is pulled up to".
+    # A landmark clause: "the table the grey stool is tucked under".
     if q.anchor_category is None:
         head = _clause_landmark(q, head)
-    # "the table between the sofa and the armchair": two landmarks.
+    # "the lamp between the bed and the wardrobe": two landmarks.
     if q.anchor_category is None:
         head = _between(q, head)
     # Relation: "<target> next to the <anchor>".
@@ -355,12 +355,12 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
         # "pool table", "power plant": WordNet names another object ending in a category word.
         cat, span = None, None
     if cat is not None and cat not in BY_NAME and find_activity(head) is not None:
-        # "somewhere to leave my phone", "where can I put my books": the thing is what the
+        # "somewhere to leave my phone", "where can I stash my board games": the thing is what the
         # activity is about; the target is the furniture that serves it.
         cat, span = None, None
     q.category = cat
     if cat == "plant":
-        # "the cactus", "the prickly plant": the growth form the word implies, checked against the points.
+        # "the cactus", "the spiny pot plant": the growth form the word implies, checked against the points.
         grams = {" ".join(words[i:i + n]) for n in (1, 2, 3) for i in range(len(words) - n + 1)}
         q.shapes = list(dict.fromkeys([*q.shapes, *sorted({_GROWTH[g] for g in grams if g in _GROWTH})]))
     known = (set(_FILLER) | set(LEXICON) | set(ALIASES) | set(_SHAPES) | _SIZE_TOKENS | set(_SUPERLATIVE)
@@ -417,13 +417,13 @@ def goal_query(g: GoalParse, embedder: TextEmbedder | None = None) -> ParsedQuer
     q.side = g.side
     q.structure = describe(g)
     if q.ordinal is None:
-        # "the second bookshelf from the door", "the first desk you reach": an ordinal on the head,
+        # "the third lamp from the door", "the first armchair you reach": an ordinal on the head,
         # counted in the order a route or a predicate gives.
         q.ordinal = next((_ORDINALS[m.lower()] for m in g.modifiers if m.lower() in _ORDINALS), None)
     if q.generic and not (q.has_attributes or q.ordinal or q.origin_room or q.side):
         q.generic = False  # "the thing" alone says nothing that could pick one object
     if q.room is None:
-        # "walking down the hallway from the bedroom door": a room walked along is where the
+        # "going along the corridor from the kitchen door": a room walked along is where the
         # target stands when the route names no room it goes into.
         q.room = next((r for role, r in g.rooms if role == "along" and r != q.origin_room), None)
     if q.origin_room is not None and q.ordinal_from == _FROM_ROBOT:

@@ -35,8 +35,8 @@ class ParsedQuery:
     purpose: str | None = None  # the request named a use ("somewhere to sit"), not an object
     negations: list[str] = field(default_factory=list)  # phrases the target must NOT match ("white")
     ordinal: int | None = None  # 2 for "the second closest"
-    proximity_to_anchor: bool = False  # "the chair closest to the table": distance to the anchor
-    anchor2_category: str | None = None  # the second landmark of "between the sofa and the armchair"
+    proximity_to_anchor: bool = False  # "the stool nearest the stove": distance to the anchor
+    anchor2_category: str | None = None  # the second landmark of "between the bed and the wardrobe"
     anchor2_phrase: str | None = None
     #: How the goal was read: "patterns" or the parser's name; notes say what could not be read.
     parser: str = ""
@@ -45,7 +45,7 @@ class ParsedQuery:
     dropped_words: list[str] = field(default_factory=list)
     origin_room: str | None = None  # the room a route comes from ("coming out of the bathroom")
     side: str | None = None  # "left" / "right" as seen walking the route into ``room``
-    #: What an ordinal counts from or along ("the second bookshelf from the door"): a phrase.
+    #: What an ordinal counts from or along ("the third lamp from the door"): a phrase.
     ordinal_from: str | None = None
     structure: dict[str, object] = field(default_factory=dict)  # the parse of the goal (head, modifiers, ...)
     #: The target was named by a word for any object ("the third thing you reach", "the one by the

@@ -2,7 +2,7 @@
 each goal its head object, the words attached to it, its landmark phrases, the clause each room
 belongs to (where the target stands, where one comes from, what one walks through) and a side
 ("on your left"). Only words the parse attaches to the head, or to the clause that leads to it,
-reach the mapping onto ``ParsedQuery`` (``mapping.py``): "once in a blue moon I sit in the
+reach the mapping onto ``ParsedQuery`` (``mapping.py``): "when I'm feeling blue I sit in the
 armchair" asks for an armchair of any colour.
 
 The parser is spaCy's English pipeline ``en_core_web_sm`` 3.8 (MIT; tagger and dependency parser),
@@ -88,7 +88,7 @@ class GoalParse:
     modifiers: list[str] = field(default_factory=list)  # words attached to the head ("blue", "velvet")
     landmarks: list[tuple[str, str]] = field(default_factory=list)  # (relation, landmark phrase)
     rooms: list[tuple[str, str]] = field(default_factory=list)  # (role, room): "target", "origin", "passed"
-    origin_room: str | None = None  # "coming out of the bathroom into the lounge": bathroom
+    origin_room: str | None = None  # "stepping out of the kitchen into the hall": kitchen
     side: str | None = None  # "on your left": left, as seen walking the route
     dropped: list[str] = field(default_factory=list)  # words not attached to the head: never attributes
     parser: str = "patterns"
@@ -212,7 +212,7 @@ def split_goals(text: str) -> list[str]:
         if not p:
             continue
         if out and not pending and not seq and _points_back(p):
-            out[-1] = f"{out[-1]} {p}"  # "Which lamp is second from the door? Go there.": the same goal
+            out[-1] = f"{out[-1]} {p}"  # "Which stool comes second from the door? Take me to it.": the same goal
             continue
         p = f"{pending} {p}".strip() if pending else p
         if _names_goal(p, seq):
@@ -322,7 +322,7 @@ def _depth(t: Token) -> int:
 
 def _is_landmark(t: Token) -> bool:
     """Whether the noun ``t`` is the object of a landmark preposition ("next to the fridge") or
-    the subject of a clause about another object ("the desk the chair is pulled up to")."""
+    the subject of a clause about another object ("the table the stool is tucked under")."""
     if t.dep_ == "pobj" and t.head.head.lemma_.lower() in _START_VERBS:
         return True
     if t.dep_ == "pobj" and t.head.text.lower() in _LANDMARK_PREPS:
@@ -338,11 +338,11 @@ def _governor(t: Token) -> str:
     """The preposition or verb that governs a room noun, with "out of" read as one word."""
     h = t.head
     if (t.dep_ == "pobj" and h.head.lower_ in _DOORS) or (t.dep_ == "compound" and h.lower_ in _DOORS):
-        return "door"  # "the door to the hall", "the hall door": the room on the door's other side
+        return "door"  # "the door to the landing", "the landing door": the room on the door's other side
     if t.i + 1 < len(t.doc) and t.doc[t.i + 1].lower_ in _DOORS:
         return "door"  # "the bathroom door" however the parser attached the two nouns
     if t.dep_ == "pobj" and h.i > 0 and h.lower_ in _DOOR_PREPS and t.doc[h.i - 1].lower_ in _DOORS:
-        # "the second sink from the door to the lounge" with "to the lounge" hung on the sink by
+        # "the third stool from the door to the hall" with "to the hall" hung on the stool by
         # the parser: a room right after "door to" is still the door's other side.
         return "door"
     if t.dep_ == "pobj":
@@ -395,7 +395,7 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
     keep = {t.i for t in doc}
     named = {i for m in mentions for i in range(m[0], m[1])} | room_tokens
     # Up the tree from the head: a phrase or clause hanging on the way that names no object or
-    # room but carries an attribute word ("once in a blue moon", "when I feel blue", "nip round")
+    # room but carries an attribute word ("every blue moon", "when I feel blue", "nip round")
     # is not about the target; everything else stays for the mapping's patterns.
     on_path, node = {head.i}, head
     while node.head.i != node.i and len(on_path) < 64:
@@ -417,7 +417,7 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
         rh = _span_head(doc, s2, e2)
         gov = _governor(rh)
         if gov == "door":
-            continue  # "from the door to the hall": the mapping reads the door phrase whole (count.py)
+            continue  # "from the door to the landing": the mapping reads the door phrase whole (count.py)
         if gov in _ROOM_ORIGIN or gov in _ROOM_PASSED:
             prep = rh.head if rh.dep_ == "pobj" else rh
             drop = {t.i for t in prep.subtree}

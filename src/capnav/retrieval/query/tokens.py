@@ -336,7 +336,7 @@ _ORDINALS = {"first": 1, "1st": 1, "second": 2, "2nd": 2, "third": 3, "3rd": 3, 
 
 
 def _room_before(words: list[str], start: int) -> tuple[str | None, int]:
-    """A room named just before the target noun ("the kitchen stool"): (room, its first word)."""
+    """A room named just before the target noun ("the office lamp"): (room, its first word)."""
     for n in (2, 1):
         if start - n >= 0:
             gram = " ".join(words[start - n:start])
