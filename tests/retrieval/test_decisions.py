@@ -183,7 +183,8 @@ def test_the_room_with_a_landmark_is_the_landmarks_region(retriever):
 
 def test_an_alternative_does_not_serve_a_bare_name_whose_category_is_absent(retriever):
     # No dining table and no ottoman in the flat: the coffee table or a stool must not stand in.
-    assert not ask(retriever, "head for the dining table please", category="table", category_alternatives={"coffee table": 0.8}).found
+    assert not ask(retriever, "head for the dining table please", category="table",
+                   category_alternatives={"coffee table": 0.8}).found
     assert not ask(retriever, "take me to the pouf", category="ottoman", category_alternatives={"stool": 0.5}).found
     assert not ask(retriever, "go to the round table", category="table", shapes=["round"],
                    category_alternatives={"coffee table": 0.8}).found
