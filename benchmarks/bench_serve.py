@@ -6,9 +6,10 @@ loopback port, rate limit off, its default queue and ``--workers`` worker proces
 with ``--pool threads``). For each row,
 ``clients`` concurrent keep-alive connections ask seeded instructions back to back until
 ``--asks`` answers are in (at least 4 per client), while one more connection polls ``/healthz``
-every 20 ms: a robot's watchdog, which must not wait behind the asks. With a robot position the
-server also picks the goal pose and plans the A* path to it; its own CPU time per ask is split
-into the ask (retrieval and, with a robot, the goal pose) and the path.
+every 20 ms from a process of its own (not behind the clients' event loop): a robot's watchdog,
+which must not wait behind the asks. With a robot position the server also picks the goal pose
+and plans the A* path to it; its own CPU time per ask is split into the ask (retrieval and, with
+a robot, the goal pose) and the path.
 
 Printed per row: asks/s, p50/p95 latency, errors (any non-200), /healthz p95 during the burst,
 the workers' CPU ms per ask (p50), the event loop thread's CPU per ask (with worker threads the
@@ -25,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import multiprocessing as mp
 import os
 import socket
 import subprocess
@@ -32,6 +34,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import httpx
 import numpy as np
@@ -74,6 +77,24 @@ def load() -> float:
     return os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
 
 
+CTX = mp.get_context("spawn")
+
+
+def watchdog(url: str, stop: Any, conn: Any) -> None:
+    """A robot's watchdog in a process of its own (not behind the clients' event loop): GET
+    /healthz every 20 ms until ``stop``; sends back the seconds each took."""
+    took: list[float] = []
+    with httpx.Client(base_url=url, timeout=30) as h:
+        h.get("/healthz")
+        conn.send("polling")
+        while not stop.is_set():
+            t0 = time.perf_counter()
+            h.get("/healthz")
+            took.append(time.perf_counter() - t0)
+            time.sleep(0.02)
+    conn.send(took)
+
+
 async def warm(url: str, qs: list[tuple[str, list[float]]], workers: int) -> None:
     """Ask every instruction as many times as there are workers (they share one queue), with and
     without the robot, untimed: every row then meets the caches a running server has (verifier
@@ -95,8 +116,6 @@ async def burst(url: str, qs: list[tuple[str, list[float]]], clients: int, asks:
     cpu_ask: list[float] = []
     cpu_plan: list[float] = []
     errors = 0
-    health: list[float] = []
-    done = asyncio.Event()
     counter = iter(range(total))
 
     async def client(c: httpx.AsyncClient) -> None:
@@ -118,24 +137,20 @@ async def burst(url: str, qs: list[tuple[str, list[float]]], clients: int, asks:
             cpu_ask.append(ms["ask_cpu"])
             cpu_plan.append(ms["plan_cpu"])
 
-    async def watchdog() -> None:
-        async with httpx.AsyncClient(base_url=url, timeout=30) as h:
-            while not done.is_set():
-                t0 = time.perf_counter()
-                await h.get("/healthz")
-                health.append(time.perf_counter() - t0)
-                await asyncio.sleep(0.02)
-
     limits = httpx.Limits(max_connections=clients, max_keepalive_connections=clients)
     async with httpx.AsyncClient(base_url=url, timeout=120, limits=limits) as c:
         for text, _ in qs[:clients]:  # open the connections (first requests of a connection)
             await c.post("/api/query", json={"text": text, "k": 5})
-        dog = asyncio.ensure_future(watchdog())
+        stop, (mine, theirs) = CTX.Event(), CTX.Pipe()
+        dog = CTX.Process(target=watchdog, args=(url, stop, theirs), daemon=True)
+        dog.start()
+        mine.recv()  # polling
         t0, l0 = time.perf_counter(), loop_cpu(pid)
         await asyncio.gather(*(client(c) for _ in range(clients)))
         wall, loop_s = time.perf_counter() - t0, loop_cpu(pid) - l0
-        done.set()
-        await dog
+        stop.set()
+        health = mine.recv()
+        dog.join(30)
     ms = np.asarray(lat) * 1e3
     return {"n": len(lat), "rate": len(lat) / wall, "p50": float(np.percentile(ms, 50)),
             "p95": float(np.percentile(ms, 95)), "errors": errors,
