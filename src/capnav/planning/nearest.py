@@ -34,7 +34,7 @@ from capnav.planning.search import (
 )
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _box_h(r: int, c: int, box: NDArray[np.int64]) -> float:
     dr = max(box[0] - r, 0, r - box[2])
     dc = max(box[1] - c, 0, c - box[3])
@@ -42,7 +42,7 @@ def _box_h(r: int, c: int, box: NDArray[np.int64]) -> float:
     return (SQRT2 - 1.0) * lo + max(dr, dc)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _resume(w: NDArray[np.floating], g: NDArray[np.float64], state: NDArray[np.uint8], hf: NDArray[np.float64],
             hi: NDArray[np.int64], size: int, target: NDArray[np.bool_], box: NDArray[np.int64], hscale: float
             ) -> tuple[int, int, NDArray[np.float64], NDArray[np.int64]]:
