@@ -67,8 +67,9 @@ def test_jobs_run_in_child_processes_with_their_state(pool: ProcessPool) -> None
 
 def test_full_pool_is_busy_and_late_job_is_overtime(pool: ProcessPool) -> None:
     async def go() -> list[object]:
-        jobs = [pool.run(functools.partial(nap, 1.5), 30) for _ in range(3)]  # 2 running + 1 queued
-        await asyncio.sleep(0.3)
+        jobs = [asyncio.ensure_future(pool.run(functools.partial(nap, 1.5), 30)) for _ in range(3)]
+        await asyncio.sleep(0.3)  # admitted: 2 running, 1 waiting
+        assert pool.in_flight == 3
         busy = pool.run(who, 30)
         late = pool.run(functools.partial(nap, 5.0), 0.5)
         return await asyncio.gather(*jobs, busy, late, return_exceptions=True)
