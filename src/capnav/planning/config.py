@@ -38,11 +38,18 @@ class PlannerConfig:
     max_replans: int = 20  # collisions tolerated during execution before giving up
     probe_step: float = 0.03  # m, bumper probe after a contact (0 = assume the obstacle is ahead)
     blocked_mark_radius: float = 0.08  # m, obstacle disk stamped ahead of the agent on a collision
+    # A graze is slid off like a bumper robot does: step this far away from the contact, sideways to
+    # the way it drives, and drive on; at most ``max_slides`` times per waypoint while each gets closer
+    # (0 = mark every contact). A waypoint the world keeps the agent ``slide_tolerance`` from is passed.
+    slide_step: float = 0.03  # m
+    max_slides: int = 8
+    slide_tolerance: float = 0.05  # m
     max_steps: int = 2000  # discrete-action budget when the agent has no move_to
 
     def __post_init__(self) -> None:
         for name in ("robot_radius", "safety_margin", "goal_margin", "escape_radius", "blocked_mark_radius",
-                     "clearance_band", "clearance_cost", "probe_step", "eye_height"):
+                     "clearance_band", "clearance_cost", "probe_step", "eye_height", "slide_step",
+                     "slide_tolerance"):
             v = getattr(self, name)
             if not v >= 0.0:
                 raise InputError(f"PlannerConfig.{name} must be >= 0, got {v}")
@@ -50,8 +57,8 @@ class PlannerConfig:
             raise InputError(f"PlannerConfig.reach must be > 0, got {self.reach}")
         if self.unknown_cost is not None and not self.unknown_cost >= 1.0:
             raise InputError(f"PlannerConfig.unknown_cost must be >= 1 or None (blocked), got {self.unknown_cost}")
-        if self.max_replans < 0 or self.max_steps < 1:
-            raise InputError("PlannerConfig.max_replans must be >= 0 and max_steps >= 1")
+        if self.max_replans < 0 or self.max_steps < 1 or self.max_slides < 0:
+            raise InputError("PlannerConfig.max_replans and max_slides must be >= 0 and max_steps >= 1")
 
     @property
     def inflation(self) -> float:

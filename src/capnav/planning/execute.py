@@ -1,9 +1,12 @@
 """Execution: drive a simulator (or robot) agent along the planned path to the goal.
 
 The agent follows the waypoints with ``move_to`` (straight segments, stops at contact) or, when it
-only has discrete actions, with turn / forward steps. A contact means the map missed an obstacle:
-the cells ahead of the agent are marked blocked, and goal and path are chosen again from where the
-agent stands, up to ``max_replans`` times.
+only has discrete actions, with turn / forward steps. A graze at the agent's side is slid off (a
+passage may have just the robot's clearance, a few centimetres less on the map); a contact it cannot
+slide off means the map missed an obstacle: the cells ahead of the agent are marked blocked, and goal
+and path are chosen again from where the agent stands, up to ``max_replans`` times. A contact the
+map already holds teaches nothing, so the same plan would come back: the goal cells under the agent
+are refused instead, and a goal that was only the closest the map allows ends the drive there.
 """
 
 from __future__ import annotations
@@ -17,7 +20,7 @@ from numpy.typing import NDArray
 
 from capnav.core.errors import CapNavError
 from capnav.core.footprint import footprint_distance
-from capnav.core.grid import OccupancyGrid
+from capnav.core.grid import OCCUPIED, OccupancyGrid
 from capnav.planning.config import PlannerConfig
 from capnav.planning.costmap import Costmap, build_costmap, mark_blocked
 from capnav.planning.goal import GoalPose, check_footprint, select_goal
@@ -98,6 +101,8 @@ def navigate_to(agent: StepAgent, occ: OccupancyGrid, target_footprint: NDArray[
     reason = ""
     first = True
     backed = False
+    held = False  # stopped by a contact the map already held
+    held_at: set[tuple[int, ...]] = set()  # cells of such contacts
     while True:
         try:
             goal, plan, note = levels.plan(fp, log.xy())
@@ -123,27 +128,69 @@ def navigate_to(agent: StepAgent, occ: OccupancyGrid, target_footprint: NDArray[
         first = False
         plans.append(plan)
         events.extend([*plan.notes, *([note] if note else [])])
-        blocked_at = _follow(agent, plan.waypoints, cfg, log)
-        if blocked_at is None:
+        slides: list[float] = []
+        contact = _follow(agent, plan.waypoints, cfg, log, slides)
+        if slides:
+            recovery.append(f"slid {sum(slides):.2f} m off {len(slides)} graze(s) instead of marking them")
+            events.append(recovery[-1])
+        if contact is None:
             _face(agent, goal.yaw, log)
             reason = goal.reason
             break
-        n = levels.mark(blocked_at, log.xy())
+        blocked_at = contact[0]
         here = np.asarray(log.xy()).reshape(1, 2)
         if footprint_distance(here, fp)[0] <= cfg.reach - cfg.goal_margin:
             _face(agent, goal.yaw, log)
             reason = "stopped within reach after a contact (the map missed an obstacle near the object)"
             events.append(f"contact near ({blocked_at[0]:.2f}, {blocked_at[1]:.2f}) within reach; stopping")
             break
-        replans += 1
-        events.append(f"contact near ({blocked_at[0]:.2f}, {blocked_at[1]:.2f}); {n} cells blocked; replanning")
+        n = levels.mark(blocked_at, log.xy())
+        if n == 0:  # felt where the map has it already: what stopped the way ahead is not drawn there
+            n = levels.mark(blocked_at := contact[1], log.xy())
+        at = f"contact near ({blocked_at[0]:.2f}, {blocked_at[1]:.2f})"
+        if n == 0:
+            # Nothing new to block: the same plan would come back. Near its goal the agent stands as
+            # close to it as the world lets it: a goal that was only the closest the map allows ends
+            # the drive there, another is refused. Farther off, the way is blocked where the map
+            # already has the obstacle (the agent stands in its margin): back out the way it came,
+            # and stop when the same contact comes back.
+            short = float(np.linalg.norm(goal.xy - here[0]))
+            cell = tuple(int(v) for v in occ.spec.to_cell(blocked_at))
+            near_goal = short <= cfg.robot_radius + cfg.slide_tolerance
+            if near_goal and not goal.reached_within_reach:
+                _face(agent, goal.yaw, log)
+                held = True
+                reason = (f"stopped {short:.2f} m short of the goal against an obstacle the map already holds "
+                          f"(a replan would learn nothing): {goal.reason}")
+                events.append(f"{at} already on the map; stopping as close as it gets")
+                break
+            if cell in held_at:
+                held = True
+                reason = (f"stopped {short:.2f} m short of the goal: the same contact again at ({blocked_at[0]:.2f}, "
+                          f"{blocked_at[1]:.2f}), which the map already holds (the way is narrower than the map "
+                          f"shows): {goal.reason}")
+                events.append(f"{at} already on the map, again; stopping")
+                break
+            held_at.add(cell)
+            replans += 1
+            if near_goal:
+                levels.refuse(here[0])
+                events.append(f"{at} already on the map ({short:.2f} m short of the goal); goals where it stands "
+                              "refused; replanning")
+            else:
+                moved = _back_out(agent, cfg, log)
+                recovery.append(f"backed out {moved:.2f} m along the way it came (a contact the map already held)")
+                events.append(f"{at} already on the map; {recovery[-1]}; replanning")
+        else:
+            replans += 1
+            events.append(f"{at}; {n} cells blocked; replanning")
         if replans > cfg.max_replans:
             reason = f"gave up after {cfg.max_replans} replans (the map keeps disagreeing with the world)"
             break
     pose = tuple(float(v) for v in agent.pose)
     dist = float(footprint_distance(np.asarray(pose[:2]).reshape(1, 2), fp)[0])
     reached = dist <= cfg.reach
-    if not reached and reason == (goal.reason if goal else ""):
+    if not reached and (held or reason == (goal.reason if goal else "")):
         reason = f"stopped {dist:.2f} m from the object (reach {cfg.reach:.2f} m): {reason}"
     return NavResult(reached, (pose[0], pose[1], pose[2]), log.length, replans,
                      plans[-1].waypoints if plans else np.empty((0, 2)), reason, goal, dist, log.array(), plans,
@@ -156,7 +203,10 @@ class _Levels:
     Level 0 is the config. When it leaves the object out of reach (a gap narrower than the robot
     plus margin, or the start boxed in by the inflation), ``config.relax`` allows two more: the
     bare robot radius, then the radius less half a cell (a grid cell whose centre is clear may
-    still fit the robot: the grid is coarser than the geometry). Contacts will tell if not.
+    still fit the robot: the grid is coarser than the geometry). Contacts will tell if not. A
+    level under the true radius may drive through such cells but stops only where the robot's
+    disk fits between the obstacle cells' centres. Goal cells the agent could not get to
+    (``refuse``) are no goal on any level.
     """
 
     def __init__(self, occ: OccupancyGrid, cfg: PlannerConfig, costmap: Costmap | None,
@@ -176,6 +226,25 @@ class _Levels:
         # be shared: a contact mark does not move a wall).
         self.maps = {0: Costmap(OccupancyGrid(base.spec, base.occ.cells.copy()), base.weights.copy(), self.columns,
                                 dict(base.cache))}
+        self.refused = np.zeros(base.weights.shape, dtype=bool)
+
+    def refuse(self, xy: NDArray[np.float64]) -> None:
+        """No goal within the robot's radius (and half a cell) of ``xy`` from now on."""
+        spec = self.maps[0].spec
+        rr, cc = np.indices(self.refused.shape)
+        rc = spec.to_cell(np.asarray(xy, dtype=np.float64))
+        self.refused |= np.hypot(rr - rc[0], cc - rc[1]) * spec.resolution <= self.radius + 0.5 * spec.resolution
+
+    def _allowed(self, i: int) -> NDArray[np.bool_]:
+        """Cells that may be goals on level ``i``: not refused, and under the true radius, where the
+        robot's disk fits between the obstacle cells' centres."""
+        if self.cfgs[i].robot_radius >= self.radius - 1e-9:
+            return ~self.refused
+        from scipy import ndimage
+
+        cm = self.maps[i]
+        clear = ndimage.distance_transform_edt(cm.occ.cells != OCCUPIED) * cm.spec.resolution
+        return ~self.refused & (clear >= self.radius - 1e-6)
 
     def _map(self, i: int) -> Costmap:
         if i not in self.maps:  # built lazily from level 0's grid, so it carries the marks so far
@@ -184,13 +253,14 @@ class _Levels:
         return self.maps[i]
 
     def plan(self, fp: NDArray[np.float64], here: tuple[float, float]) -> tuple[GoalPose, PlannedPath, str]:
-        """Goal and path at the strictest level that gets within reach (else level 0's fallback)."""
+        """Goal and path at the strictest level that gets within reach, else the fallback goal
+        closest to the object over the levels (the strictest of equals)."""
         fallback: tuple[GoalPose, PlannedPath, str] | None = None
         error: CapNavError | None = None
         for i, cfg in enumerate(self.cfgs):
             cm = self._map(i)
             try:
-                goal = select_goal(cm.occ, fp, here, cfg, cm, z_range=self.z_range)
+                goal = select_goal(cm.occ, fp, here, cfg, cm, z_range=self.z_range, allowed=self._allowed(i))
                 plan = plan_path(cm.occ, here, goal.xy, cfg, cm)
             except CapNavError as e:
                 error = error or e
@@ -201,7 +271,8 @@ class _Levels:
                                       f"at {self.cfgs[0].inflation:.3f} m")
             if goal.reached_within_reach:
                 return goal, plan, note
-            fallback = fallback or (goal, plan, note)
+            if fallback is None or goal.distance_to_object < fallback[0].distance_to_object - 1e-9:
+                fallback = (goal, plan, note)
         if fallback is not None:
             return fallback
         assert error is not None
@@ -209,17 +280,10 @@ class _Levels:
 
     def mark(self, xy: NDArray[np.float64], robot_xy: tuple[float, float]) -> int:
         """Block a contact on every level, grown by the full robot radius + margin even on relaxed
-        levels (a contact is proof the relaxation was too optimistic there). When that adds
-        nothing the obstacle must be larger than the mark: grow it, so a replan never repeats."""
+        levels (a contact is proof the relaxation was too optimistic there); the number of cells
+        newly blocked on any level (0: the map held the contact already)."""
         radius = self.cfgs[0].blocked_mark_radius
-        n = 0
-        for _ in range(4):
-            for cm in self.maps.values():
-                n = max(n, mark_blocked(cm, xy, radius, self.cfgs[0], np.asarray(robot_xy)))
-            if n:
-                break
-            radius *= 2
-        return n
+        return max(mark_blocked(cm, xy, radius, self.cfgs[0], np.asarray(robot_xy)) for cm in self.maps.values())
 
 
 class _Log:
@@ -247,20 +311,62 @@ class _Log:
         return np.asarray(self.points, dtype=np.float64)
 
 
-def _follow(agent: StepAgent, waypoints: NDArray[np.float64], cfg: PlannerConfig, log: _Log
-            ) -> NDArray[np.float64] | None:
-    """Drive through the waypoints; return the contact point ahead of the agent when blocked."""
+def _follow(agent: StepAgent, waypoints: NDArray[np.float64], cfg: PlannerConfig, log: _Log,
+            slides: list[float] | None = None) -> NDArray[np.float64] | None:
+    """Drive through the waypoints; when blocked, return (2, 2): where the contact is (felt around)
+    and the point just beyond the agent's rim on the way it was going.
+
+    An agent with ``move_to`` slides off a graze (:func:`_slide`); how far each slide moved it is
+    appended to ``slides``."""
     move_to = getattr(agent, "move_to", None)
     for wp in waypoints[1:]:
-        if move_to is not None:
+        if move_to is None:
+            if not _drive_discrete(agent, wp, cfg, log):
+                return np.stack([_contact_point(agent, wp, cfg, log), _ahead(log, wp, cfg)])
+            continue
+        shift = np.zeros(2)  # how far slides moved this leg sideways: drive on parallel to it
+        for tries in range(cfg.max_slides + 1):
+            aim = wp + shift
             before = len(_trajectory(agent))
-            ok = bool(move_to(float(wp[0]), float(wp[1])))
+            ok = bool(move_to(float(aim[0]), float(aim[1])))
             log.record(_trajectory(agent)[before:])
-        else:
-            ok = _drive_discrete(agent, wp, cfg, log)
-        if not ok:
-            return _contact_point(agent, wp, cfg, log)
+            if ok:
+                break
+            here = np.asarray(log.xy())
+            normal = _probe(agent, aim, cfg, log)
+            if float(np.linalg.norm(aim - here)) <= cfg.slide_tolerance:
+                break  # as close to this waypoint as the world lets it: on to the next
+            step = np.zeros(2) if tries == cfg.max_slides else _slide(agent, aim, normal, cfg, log)
+            if float(np.linalg.norm(step)) <= 1e-3 or float(np.linalg.norm(shift + step)) > cfg.robot_radius:
+                return np.stack([np.asarray(log.xy()) + normal * (cfg.robot_radius + cfg.blocked_mark_radius),
+                                 _ahead(log, aim, cfg)])
+            shift += step
+            if slides is not None:
+                slides.append(float(np.linalg.norm(step)))
     return None
+
+
+def _slide(agent: StepAgent, target: NDArray[np.float64], normal: NDArray[np.float64], cfg: PlannerConfig,
+           log: _Log) -> NDArray[np.float64]:
+    """Step up to ``slide_step`` away from a contact, sideways to the way to ``target``, as a bumper
+    robot slides off what it grazed; stopped by something on the other side, to the middle of the
+    room between the two. Returns the displacement (zero for a contact head-on: nothing to slide
+    along)."""
+    here = np.asarray(log.xy())
+    d = np.asarray(target, dtype=np.float64) - here
+    d /= max(float(np.linalg.norm(d)), 1e-9)
+    side = -(normal - float(normal @ d) * d)
+    if float(np.linalg.norm(side)) < 0.3 or cfg.slide_step <= 0:  # within ~17 degrees of head-on
+        return np.zeros(2)
+    side /= float(np.linalg.norm(side))
+    p = here + side * cfg.slide_step
+    before = len(_trajectory(agent))
+    move_to = agent.move_to  # type: ignore[attr-defined]
+    if not move_to(float(p[0]), float(p[1])):
+        mid = (here + np.asarray(agent.pose[:2], dtype=np.float64)) / 2
+        move_to(float(mid[0]), float(mid[1]))
+    log.record(_trajectory(agent)[before:])
+    return np.asarray(log.xy()) - here
 
 
 #: How far the executor backs out along the way it came when boxed in (m).
@@ -274,19 +380,20 @@ def _back_out(agent: StepAgent, cfg: PlannerConfig, log: _Log, distance: float =
     if len(traj) < 2:
         return 0.0
     here = np.asarray(traj[-1], dtype=np.float64)
-    back, total = [], 0.0
-    prev = here
+    # Only the points that take it farther from here: the bumper's probes went out and back.
+    back: list[NDArray[np.float64]] = []
+    far = 0.0
     for p in reversed(traj[:-1]):
         q = np.asarray(p, dtype=np.float64)
-        step = float(np.linalg.norm(q - prev))
-        if step < 1e-9:
+        d = float(np.linalg.norm(q - here))
+        if d <= far + 1e-6:
             continue
-        if total + step >= distance:  # stop part-way along this segment
-            back.append(prev + (q - prev) * ((distance - total) / step))
+        if d >= distance:  # stop part-way along this segment
+            last = back[-1] if back else here
+            back.append(last + (q - last) * ((distance - far) / (d - far)))
             break
-        total += step
         back.append(q)
-        prev = q
+        far = d
     if not back:
         return 0.0
     start = np.asarray(log.xy(), dtype=np.float64)
@@ -301,13 +408,30 @@ def _trajectory(agent: object) -> list[tuple[float, float]]:
     return [(float(p[0]), float(p[1])) for p in traj]
 
 
+def _ahead(log: _Log, target: NDArray[np.float64], cfg: PlannerConfig) -> NDArray[np.float64]:
+    here = np.asarray(log.xy())
+    d = np.asarray(target, dtype=np.float64) - here
+    n = float(np.linalg.norm(d))
+    if n < 1e-9:
+        return here
+    return here + d / n * (cfg.robot_radius + cfg.blocked_mark_radius)
+
+
 def _contact_point(agent: StepAgent, target: NDArray[np.float64], cfg: PlannerConfig, log: _Log
                    ) -> NDArray[np.float64]:
-    """Where the unseen obstacle is: just beyond the agent's rim, in the direction of contact.
+    """Where the unseen obstacle is: just beyond the agent's rim, in the direction of contact."""
+    x, y, _ = (float(v) for v in agent.pose)
+    return np.array([x, y]) + _probe(agent, target, cfg, log) * (cfg.robot_radius + cfg.blocked_mark_radius)
+
+
+def _probe(agent: StepAgent, target: NDArray[np.float64], cfg: PlannerConfig, log: _Log) -> NDArray[np.float64]:
+    """The unit direction from the agent to what stopped it.
 
     The direction of travel is a poor guess when the agent grazed something at its side (it would
     seal a corridor the agent can pass), so an agent with ``move_to`` feels around like a bumper:
-    tiny moves in 8 directions, each undone, and the blocked ones point at the obstacle.
+    tiny moves in 8 directions, each undone. Each blocked one points at an obstacle, weighted by
+    how little of the move it got (in a passage with less slack than the probe both walls block,
+    the one it touches the most).
     """
     x, y, yaw = (float(v) for v in agent.pose)
     d = np.asarray(target, dtype=np.float64) - (x, y)
@@ -315,21 +439,20 @@ def _contact_point(agent: StepAgent, target: NDArray[np.float64], cfg: PlannerCo
     u = d / n if n > 1e-6 else np.array([math.cos(yaw), math.sin(yaw)])
     move_to = getattr(agent, "move_to", None)
     if move_to is not None and cfg.probe_step > 0:
-        blocked = []
+        pushes = []
         for a in np.linspace(0.0, 2 * np.pi, 8, endpoint=False):
             v = np.array([math.cos(a), math.sin(a)])
-            if move_to(x + cfg.probe_step * v[0], y + cfg.probe_step * v[1]):
+            if not move_to(x + cfg.probe_step * v[0], y + cfg.probe_step * v[1]):
+                got = math.hypot(agent.pose[0] - x, agent.pose[1] - y)
+                pushes.append(v * (1.0 - min(got / cfg.probe_step, 1.0)))
+            if math.hypot(agent.pose[0] - x, agent.pose[1] - y) > 1e-9:
                 move_to(x, y)
-            else:
-                blocked.append(v)
-                if math.hypot(agent.pose[0] - x, agent.pose[1] - y) > 1e-9:
-                    move_to(x, y)
         log.record()
-        if blocked:
-            m = np.sum(blocked, axis=0)
+        if pushes:
+            m = np.sum(pushes, axis=0)
             if float(np.hypot(*m)) > 1e-6:
                 u = m / float(np.hypot(*m))
-    return np.array([x, y]) + u * (cfg.robot_radius + cfg.blocked_mark_radius)
+    return np.asarray(u, dtype=np.float64)
 
 
 def _agent_radius(agent: object) -> float | None:

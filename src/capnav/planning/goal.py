@@ -84,7 +84,8 @@ def room_labels(cm: Costmap) -> NDArray[np.int32]:
 
 def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], start_xy: Any,
                 config: PlannerConfig | None = None, costmap: Costmap | None = None, *,
-                z_range: tuple[float, float] | None = None, columns: HeightColumns | None = None) -> GoalPose:
+                z_range: tuple[float, float] | None = None, columns: HeightColumns | None = None,
+                allowed: NDArray[np.bool_] | None = None) -> GoalPose:
     """The cheapest cell (path cost from ``start_xy``) within ``reach - goal_margin`` of the
     footprint that meets the goal rule (module notes); else, relaxing one condition at a time, the
     cells within ``reach``, in sight from the next room, in the room but out of sight, any seen free
@@ -92,6 +93,8 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
 
     ``z_range`` (m above the floor) is the object's height; ``columns`` (default: the costmap's)
     the map's observed heights for 3D sight. Without them every occupied cell blocks sight.
+    ``allowed`` (the grid's shape) limits which cells may be goals, not which may be driven
+    through: where the true robot fits on a relaxed costmap, and not where it failed to get.
     When no seen free cell is reachable the goal is the start cell, with the reason.
     """
     cfg = config or PlannerConfig()
@@ -100,6 +103,9 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
     cols = columns if columns is not None else cm.columns
     spec = cm.spec
     s_cell, _ = locate_start(cm, start_xy, cfg)
+    if allowed is not None and np.shape(allowed) != cm.weights.shape:
+        raise InputError(f"allowed goal cells must have the grid's shape {cm.weights.shape}, got {np.shape(allowed)}")
+    may = np.ones(cm.weights.shape, dtype=bool) if allowed is None else np.asarray(allowed, dtype=bool)
     # Only cells in the footprint's box grown by the reach can be within reach: measure those.
     lo = np.clip(spec.to_cell(fp.min(axis=0) - cfg.reach), 0, [spec.rows - 1, spec.cols - 1])
     hi = np.clip(spec.to_cell(fp.max(axis=0) + cfg.reach), 0, [spec.rows - 1, spec.cols - 1])
@@ -108,7 +114,7 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
     centres = spec.to_world(rc)
     dist = _distances(centres, fp)
     win = (slice(lo[0], hi[0] + 1), slice(lo[1], hi[1] + 1))
-    free = (cm.occ.cells[win].ravel() == FREE) & np.isfinite(cm.weights[win].ravel())
+    free = (cm.occ.cells[win].ravel() == FREE) & np.isfinite(cm.weights[win].ravel()) & may[win].ravel()
     within = free & (dist <= cfg.reach)
     near = within & (dist <= cfg.reach - cfg.goal_margin)
     person = cfg.prefer_line_of_sight
@@ -175,7 +181,8 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
                          float(dist[i]), float(cost[i]), in_sight, room)
     # No seen free floor within reach is reachable: a traversable unknown cell within reach, said so
     # (the map may have missed the floor in an occlusion shadow; on_map reports such a goal as not ok).
-    unseen = np.isfinite(cm.weights[win].ravel()) & ~free & (dist <= cfg.reach) & reach_ok
+    unseen = (np.isfinite(cm.weights[win].ravel()) & (cm.occ.cells[win].ravel() != FREE) & may[win].ravel()
+              & (dist <= cfg.reach) & reach_ok)
     if unseen.any():
         k = unseen & (dist <= cfg.reach - cfg.goal_margin)
         i = _pick(np.nonzero(k if k.any() else unseen)[0], cost, dist, not k.any(), spec.resolution)
@@ -183,7 +190,7 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
                      "cell of seen free floor lies within reach", float(dist[i]), float(cost[i]), None, None,
                      on_seen_floor=False)
     # Out of reach: the reachable seen free cell closest to the object, over the whole grid.
-    ok_all = np.isfinite(field) & (cm.occ.cells == FREE)
+    ok_all = np.isfinite(field) & (cm.occ.cells == FREE) & may
     if not ok_all.any():  # stay where the robot stands rather than stop on floor nobody saw
         xy = spec.to_world(np.asarray(s_cell))
         d0 = float(_distances(xy.reshape(1, 2), fp)[0])
