@@ -40,8 +40,9 @@ from capnav.serve.pool import Busy, Overtime
 
 log = logging.getLogger("capnav.serve")
 _STOP = "stop"
-#: Worker processes run this much nicer than the server's event loop: when asks fill the cores,
-#: a /healthz or a page request still gets a core the moment it arrives.
+#: Worker processes run this much nicer than the server's event loop, and as batch work (a worker
+#: woken by a job does not take the core from the loop that handed it over): when asks fill the
+#: cores, a /healthz or a page request still gets a core the moment it arrives.
 WORKER_NICE = 5
 
 
@@ -66,6 +67,8 @@ def _serve(index: int, make_state: Callable[[int], Any], conn: Any) -> None:
     signal.signal(signal.SIGHUP, signal.SIG_IGN)
     with contextlib.suppress(OSError, AttributeError):
         os.nice(WORKER_NICE)
+    with contextlib.suppress(OSError, AttributeError):  # Linux: a woken worker does not preempt the loop
+        os.sched_setscheduler(0, os.SCHED_BATCH, os.sched_param(0))
     try:
         state = make_state(index)
     except BaseException as e:
