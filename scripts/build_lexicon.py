@@ -32,7 +32,9 @@ is spoken to):
   (bedside table): its nearest synset, ``stand.n.04`` (a small table for holding articles), gives
   the nightstand's gloss. The counter is ``counter.n.01`` without its hyponyms (shop counters,
   bars, checkouts) plus the countertop. The toilet includes the British
-  ``water_closet.n.01`` (loo) although WordNet files it as a room. Lamps are ``lamp.n.02`` (the
+  ``water_closet.n.01`` (loo) although WordNet files it as a room, and so is every room WordNet
+  defines only by the fixture it is equipped with (``toilet.n.01``, "a room or building equipped
+  with one or more toilets": lavatory, lav, privy). Lamps are ``lamp.n.02`` (the
   furniture), not ``lamp.n.01`` (any source of light: torches, searchlights).
 - ``other``: compounds whose last word is a category word but which name something else (a pool
   table, a toilet seat, a power plant): game, operating, altar and work tables, wheelchairs,
@@ -313,6 +315,32 @@ def _growth(wn: Any, forms: dict[str, str]) -> dict[str, str]:
     return dict(sorted(out.items()))
 
 
+def _is_name(wn: Any, lemma: str) -> bool:
+    """Whether WordNet also has ``lemma`` capitalised as a person's name (noun.person)."""
+    cap = lemma.capitalize()
+    return any(s.lexname() == "noun.person" for s in wn.synsets(cap, "n")
+               if any(lem.name() == cap for lem in s.lemmas()))
+
+
+def _rooms_of_fixtures(wn: Any) -> dict[str, list[str]]:
+    """Category -> synsets of a room that WordNet defines only by that fixture ("a room or
+    building equipped with one or more toilets": lavatory, lav, privy): asking for such a room
+    is asking for the fixture, as the British ``water_closet.n.01`` (loo) already is."""
+    import re
+
+    out: dict[str, list[str]] = {}
+    for syn in wn.all_synsets("n"):
+        m = re.fullmatch(r"a room(?: or building)? equipped with (?:one or more |an? )?(?P<what>[a-z ]+)",
+                         syn.definition())
+        if not m:
+            continue
+        what = m.group("what")
+        for cat in ROOTS:
+            if what in (cat, cat + "s", cat + "es"):
+                out.setdefault(cat, []).append(syn.name() + "!")  # not its hyponyms (public toilets)
+    return out
+
+
 def _closure(wn: Any, names: list[str], excluded: set[str]) -> set[str]:
     """The synsets and their hyponyms (a name ending in "!" is taken without its hyponyms)."""
     out = {n[:-1] for n in names if n.endswith("!")}
@@ -330,6 +358,10 @@ def _build(wn: Any) -> dict[str, Any]:
     excluded = {s.name() for n in EXCLUDE for s in wn.synset(n).closure(lambda x: x.hyponyms())} | set(EXCLUDE)
     excluded |= {s.name() for n in EXCLUDE_HYPONYMS_OF for s in wn.synset(n).closure(lambda x: x.hyponyms())}
     members = {cat: _closure(wn, roots, excluded) for cat, roots in ROOTS.items()}
+    fixture_rooms: set[str] = set()
+    for cat, extra in _rooms_of_fixtures(wn).items():
+        members[cat] |= _closure(wn, extra, excluded)
+        fixture_rooms |= {n.rstrip("!") for n in extra}
     # A synset under two categories' roots belongs to the more specific one (the smaller closure).
     owner: dict[str, str] = {}
     for cat in sorted(members, key=lambda c: len(members[c]), reverse=True):
@@ -358,6 +390,8 @@ def _build(wn: Any) -> dict[str, Any]:
         if " " not in form and other_parts_of_speech(lemma):
             continue  # "settle", "lower", "console", "palm": a verb or adjective first in speech
         senses = physical_senses(lemma)
+        if senses and senses[0].name() in fixture_rooms and _is_name(wn, lemma):
+            continue  # "john": a person's name too (John), which a lower-cased instruction cannot tell
         if not senses or senses[0].name() not in owner:
             continue
         cat = owner[senses[0].name()]
