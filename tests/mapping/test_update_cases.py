@@ -159,3 +159,21 @@ def test_place_seen_empty_in_a_few_frames_is_free_in_the_grid(glimpse: int) -> N
     assert occ.cells[r, c] == FREE, "the retired chair's place is still an obstacle"
     wall = occ.spec.to_cell(np.array([[2.95, 0.0]]))[0]
     assert occ.cells[wall[0], wall[1]] != FREE
+
+
+def test_lookalike_set_where_a_thrown_out_one_stood_retires_it() -> None:
+    """The pink armchair is thrown out and the white one pushed onto its place: the white one moved,
+    the pink one is retired though its place was never seen empty (the white one fills it), and its
+    history says what stands there now."""
+    v1 = [_table(), _box(2.0, 0.6, 0.8, 0.8, 0.9, 1, ARMCHAIR, PINK),
+          _box(-2.0, 1.6, 0.8, 0.8, 0.9, 2, ARMCHAIR, WHITE)]
+    v2 = [_table(), _box(2.0, 0.8, 0.8, 0.8, 0.9, 7, ARMCHAIR, WHITE)]
+    m1 = _map(_orbit(v1))
+    pink, white = _at(m1.objects, (2.0, 0.6))[0], _at(m1.objects, (-2.0, 1.6))[0]
+    m2, rep = _update(m1, _orbit(v2))
+    assert rep.moved == [white.id] and rep.retired == [pink.id] and rep.born == [], rep.summary()
+    gone = next(o for o in m2.retired if o.id == pink.id)
+    assert gone.history[-1]["replaced_by"]["label"] == "armchair"
+    from capnav.retrieval.time import gone_reason
+
+    assert "another armchair stood at its place" in gone_reason(gone, m2)

@@ -63,8 +63,10 @@ class UpdateConfig:
 
     Gating: a frame runs the detector when ``new_share`` of its depth (every ``gate_stride``-th
     pixel, at furniture height) lies farther than one ``gate_cell`` from any old surface (0.05
-    missed a chair seen from 2 m in 160x120 frames; 0.02 found it), and so do ``window`` frames
-    either side (a track needs several hits). ``gate=False`` detects in every frame.
+    missed a chair seen from 2 m in 160x120 frames; 0.02 found it), or when an old object seen in
+    place looks ``recolour`` away from its mean colour (RGB distance of the averages, the scale of
+    the colour cue of ``likeness``); so do ``window`` frames either side (a track needs several
+    hits). ``gate=False`` detects in every frame.
 
     Matching: a new object is an old one when ``same_overlap`` of its points lie within
     ``same_radius`` of that object's points (labels compatible); a moved one when its likeness
@@ -88,6 +90,7 @@ class UpdateConfig:
     gate_cell: float = 0.1
     gate_stride: int = 4
     gate_top: float = 2.0
+    recolour: float = 60.0
     window: int = 2
     same_overlap: float = 0.3
     same_radius: float = 0.1
@@ -223,11 +226,35 @@ def _new_share(frame: Frame, T_wc: NDArray[np.float64], known: NDArray[np.int64]
     return float((~hit).sum() / ok.sum())
 
 
+def _recoloured(frame: Frame, T_cw: NDArray[np.floating], ev: _Evidence, seen: NDArray[np.bool_],
+                speaking: NDArray[np.bool_], cfg: UpdateConfig) -> bool:
+    """Whether an old object whose place this frame sees filled looks another colour now (its seen
+    points' pixels, averaged, ``recolour`` from its mean colour): a white armchair pushed onto the
+    place of a pink one leaves the geometry as it was. Averaged per object, so texture and shading
+    of single pixels do not count."""
+    sel = seen & speaking[ev.owner]
+    if not sel.any():
+        return False
+    p = ev.points[sel]
+    pc = p @ T_cw[:3, :3].T + T_cw[:3, 3]
+    K = frame.K
+    u = np.clip(np.floor(K.fx * pc[:, 0] / pc[:, 2] + K.cx).astype(np.int64), 0, frame.rgb.shape[1] - 1)
+    v = np.clip(np.floor(K.fy * pc[:, 1] / pc[:, 2] + K.cy).astype(np.int64), 0, frame.rgb.shape[0] - 1)
+    rgb = np.asarray(frame.rgb)[v, u].astype(np.float64)
+    own = ev.owner[sel]
+    cnt = np.bincount(own, minlength=ev.n).astype(np.float64)
+    mean = np.stack([np.bincount(own, rgb[:, c], minlength=ev.n) for c in range(3)], axis=1).astype(np.float64)
+    has = cnt > 0
+    mean[has] /= cnt[has, None]
+    return bool((np.linalg.norm(mean[has] - ev.colour[has], axis=1) > cfg.recolour).any())
+
+
 @dataclass
 class _Evidence:
     points: NDArray[np.float64]  # object points above the floor, all objects concatenated
     owner: NDArray[np.int64]  # index into the old objects of each point
     n: int
+    colour: NDArray[np.float64]  # (n, 3) each object's mean colour
     present: NDArray[np.int64] = field(init=False)
     empty: NDArray[np.int64] = field(init=False)
     last_present: NDArray[np.int64] = field(init=False)
@@ -245,8 +272,10 @@ def _object_evidence(objects: list[MapObject], cfg: UpdateConfig) -> _Evidence:
         p = p[p[:, 2] >= cfg.floor_clearance] if len(p) else p
         pts.append(p)
         own.append(np.full(len(p), k, np.int64))
+    colour = np.array([np.asarray(o.colors, np.float64).mean(axis=0) if len(o.colors) else np.full(3, np.nan)
+                       for o in objects]).reshape(-1, 3)
     return _Evidence(np.concatenate(pts) if pts else np.zeros((0, 3)), np.concatenate(own) if own else
-                     np.zeros(0, np.int64), len(objects))
+                     np.zeros(0, np.int64), len(objects), colour)
 
 
 # ---- matching ------------------------------------------------------------------------------
@@ -282,8 +311,9 @@ def likeness(a: MapObject, b: MapObject) -> float:
 
 
 def _assign(new: list[MapObject], old: list[MapObject], gone: NDArray[np.bool_], cfg: UpdateConfig
-            ) -> tuple[dict[int, int], dict[int, int], list[int]]:
-    """Which old object each new sighting is: (same place: new -> old, moved: old -> new, displaced old).
+            ) -> tuple[dict[int, int], dict[int, int], dict[int, int]]:
+    """Which old object each new sighting is: (same place: new -> old, moved: old -> new, displaced:
+    old -> the new sighting standing at its place).
 
     One assignment over all pairs (labels compatible), maximising the summed likeness, where a pair
     at the same place (``same_overlap`` of the new points near the old ones) adds ``place_prior``:
@@ -297,7 +327,7 @@ def _assign(new: list[MapObject], old: list[MapObject], gone: NDArray[np.bool_],
 
     nn, no = len(new), len(old)
     if nn == 0 or no == 0:
-        return {}, {}, []
+        return {}, {}, {}
     score = np.full((nn, no), -np.inf)
     same = np.zeros((nn, no), bool)
     for j, n in enumerate(new):
@@ -316,7 +346,7 @@ def _assign(new: list[MapObject], old: list[MapObject], gone: NDArray[np.bool_],
                 score[j, q] = lk
     ok = np.isfinite(score)
     if not ok.any():
-        return {}, {}, []
+        return {}, {}, {}
     rows, cols = linear_sum_assignment(np.where(ok, -score, 1e6))
     claimed: dict[int, int] = {}
     moved: dict[int, int] = {}
@@ -329,7 +359,8 @@ def _assign(new: list[MapObject], old: list[MapObject], gone: NDArray[np.bool_],
             moved[q] = j
     taken = set(claimed.values()) | set(moved)
     assigned = sorted({*claimed, *moved.values()})
-    displaced = [q for q in range(no) if q not in taken and bool(same[assigned, q].any())]
+    displaced = {q: next(j for j in assigned if same[j, q]) for q in range(no)
+                 if q not in taken and bool(same[assigned, q].any())}
     return claimed, moved, displaced
 
 
@@ -418,7 +449,7 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
         K = f.K
         depth = np.ascontiguousarray(f.depth, dtype=np.float32)
         args = (Tcw, K.fx, K.fy, K.cx, K.cy, depth, cfg.near, cfg.far, cfg.tol, cfg.margin)
-        emptied = False
+        emptied = recoloured = False
         if len(ev.points):
             codes = E_.classify_points(ev.points, *args)
             seen = np.bincount(ev.owner[codes == E_.SEEN], minlength=ev.n)
@@ -428,6 +459,7 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
             here = spoke & (seen >= cfg.present_share * (seen + thr))
             ev.empty += empty
             emptied = bool(empty.any())
+            recoloured = bool(cfg.recolour > 0) and _recoloured(f, Tcw, ev, codes == E_.SEEN, here, cfg)
             ev.present += here
             ev.last_present[here] = i
         if len(vc) and rep.frames % cfg.carve_stride == 0:
@@ -438,7 +470,7 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
         # A frame shows something new when it holds surface the map lacks: it and its neighbours run
         # the detector. One that sees through an old object's place only has its depth fused (the
         # floor where a chair stood becomes free): what is gone needs no detection.
-        changed = not cfg.gate or _new_share(f, Twc, known, cfg) >= cfg.new_share
+        changed = not cfg.gate or recoloured or _new_share(f, Twc, known, cfg) >= cfg.new_share
         if changed:
             while pending:
                 g = pending.popleft()
@@ -507,6 +539,9 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
         elif gone[q]:
             c.history = [*c.history, {"recording": k, "event": "retired", "position": np.round(o.position, 3).tolist(),
                                       "frames_empty": int(ev.empty[q]), "frames_present": int(ev.present[q])}]
+            if q in displaced:  # not seen empty: another object stands where it stood
+                n = new_objs[displaced[q]]
+                c.history[-1]["replaced_by"] = {"label": n.label, "position": np.round(n.position, 3).tolist()}
             retired.append(c)
             rep.retired.append(o.id)
         else:

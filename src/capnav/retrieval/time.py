@@ -99,5 +99,9 @@ def gone_reason(o: MapObject, cmap: CapNavMap) -> str:
     rec = retired.get("recording")
     label = next((r.get("label") for r in cmap.meta.get("recordings", []) or [] if r.get("index") == rec),
                  None) or f"recording {rec}"
+    by = retired.get("replaced_by")
+    if isinstance(by, dict) and by.get("label"):
+        return (f"the {o.label} (object {o.id}) is no longer there: {when_seen(o, cmap)}; in {label} another "
+                f"{by['label']} stood at its place and it was seen nowhere else")
     return (f"the {o.label} (object {o.id}) is no longer there: {when_seen(o, cmap)}; its place was seen empty "
             f"in {label}")
