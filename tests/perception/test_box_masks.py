@@ -60,3 +60,4 @@ def test_a_sofa_cut_by_the_image_border_is_no_wall() -> None:
     assert r[0] == 0 and r[-1] == K.height - 1 and c[-1] == K.width - 1  # it runs out of the image on three sides
     assert (m & inst).sum() >= 0.9 * inst.sum()
     assert (m & ~inst).sum() <= 0.05 * m.sum()
+

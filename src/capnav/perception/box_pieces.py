@@ -1,17 +1,17 @@
 """Keep the pieces of a box's depth mask that make one thing in 3D.
 
-A mask from a box (``box_masks``) holds what the image shows inside it, and through an open-frame chair, under
-a table or past a tight box's edge the image shows other things: a window frame behind the
-chair, the side of the cabinet beside it, a wall a metre behind. In the image they touch the
-object; in 3D they are apart from it. ``linked_pieces`` cuts the mask into smooth pieces at
-depth jumps (``box_masks.depth_jumps``), takes the largest piece as the object's core and adds,
-again and again, every piece that comes within ``link`` of what is kept (single linkage in 3D).
-The parts of one object are joined in the world (a leg under its seat, an arm over the seat, a
-backrest on its posts), so their seen points come close to each other even where the joint
-itself is hidden; the background seen around or through the object does not. A piece that is
-not linked is dropped only when it lies behind the kept ones (farther, by its median depth):
-what is seen around or through an object is behind it, while the far half of a table seen on
-both sides of a chair standing in front of it is not.
+A mask from a box (``box_masks``) holds what the image shows inside it, and through an
+open-frame chair, under a table or past a tight box's edge the image shows other things: a
+window frame behind the chair, the side of the cabinet beside it, a wall a metre behind. In the
+image they touch the object; in 3D they are apart from it. ``linked_pieces`` cuts the mask into
+smooth pieces at depth jumps (``box_masks.depth_jumps``), takes the largest piece as the
+object's core and adds, again and again, every piece that comes within ``link`` of what is
+kept (single linkage in 3D). The parts of one object are joined in the world (a leg under its
+seat, an arm over the seat, a backrest on its posts), so their seen points come close to each
+other even where the joint itself is hidden; the background seen around or through the object
+does not. A piece that is not linked is dropped only when it lies behind the kept ones
+(farther, by its median depth): what is seen around or through an object is behind it, while
+the far half of a table seen on both sides of a chair standing in front of it is not.
 """
 
 from __future__ import annotations
@@ -50,9 +50,9 @@ def _sample(idx: NDArray[np.intp], n: int) -> NDArray[np.intp]:
 
 def linked_pieces(mask: NDArray[np.bool_], depth: NDArray[np.floating], K: Any,
                   cfg: PiecesConfig = PiecesConfig()) -> NDArray[np.bool_]:
-    """The pieces of the (H, W) ``mask`` linked in 3D to its largest piece or not behind the
-    linked ones (see the module docstring); invalid-depth pixels are left as they were (they
-    lift to nothing). ``K``: the camera's intrinsics (``fx``, ``fy``, ``cx``, ``cy``)."""
+    """The pieces of the (H, W) ``mask`` linked in 3D to its largest piece or not behind the linked ones
+    (see the module docstring); invalid-depth pixels are left as they were (they lift to nothing).
+    ``K``: the camera's intrinsics (``fx``, ``fy``, ``cx``, ``cy``)."""
     if not cfg.enabled or not mask.any():
         return mask
     rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
