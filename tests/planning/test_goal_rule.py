@@ -132,3 +132,22 @@ def test_the_search_settles_targets_in_cost_order_without_the_whole_grid() -> No
     assert np.allclose(costs, [field[c] for c, _ in got])
     done = search.finish()
     assert np.allclose(done[np.isfinite(field)], field[np.isfinite(field)])
+
+
+def test_unseen_space_beyond_the_outer_wall_is_no_room_of_an_object_in_the_corner() -> None:
+    # A 4 x 4 m room mapped inside 1.5 m of unknown space (nobody saw beyond its walls); a lamp
+    # stands in its corner, its mapped box reaching into the walls. The space outside is no room
+    # the lamp is reached from: the goal is in the room, and said so.
+    pad, wall, side = 1.5, 0.1, 4.0
+    n = round((side + 2 * (pad + wall)) / RES)
+    spec = GridSpec(-pad - wall, -pad - wall, RES, n, n)
+    c = spec.to_world(np.stack(np.mgrid[0:n, 0:n], axis=-1).reshape(-1, 2)).reshape(n, n, 2)
+    inside = (c[..., 0] > 0) & (c[..., 0] < side) & (c[..., 1] > 0) & (c[..., 1] < side)
+    walls = (c[..., 0] > -wall) & (c[..., 0] < side + wall) & (c[..., 1] > -wall) & (c[..., 1] < side + wall)
+    lamp = box(3.55, 3.55, 4.05, 4.05)
+    on_lamp = (c[..., 0] >= 3.55) & (c[..., 0] <= 4.05) & (c[..., 1] >= 3.55) & (c[..., 1] <= 4.05)
+    cells = np.where(inside & ~on_lamp, FREE, np.where(walls, OCCUPIED, UNKNOWN)).astype(np.uint8)
+    occ = OccupancyGrid(spec, cells)
+    goal = select_goal(occ, lamp, (1.0, 1.0))
+    assert goal.reached_within_reach and goal.in_room is True, goal.reason
+    assert "in the object's room" in goal.reason

@@ -72,12 +72,21 @@ def check_footprint(footprint: object) -> NDArray[np.float64]:
 def room_labels(cm: Costmap) -> NDArray[np.int32]:
     """Free-space regions of the costmap's grid (one label per room, -1 on walls), computed once per
     costmap: the walkable domain is every cell not seen occupied (furniture is occupied, but a room
-    is one region around it once doorways are cut by the erosion)."""
+    is one region around it once doorways are cut by the erosion). A region mostly of unknown
+    space is no room (the band nobody saw beyond the outer walls): -1 too, so an object in a
+    corner is not given to the outside."""
     labels = cm.cache.get("rooms")
     if labels is None:
         from capnav.language.rooms import fill_gaps, segment_rooms
 
-        labels = segment_rooms(fill_gaps(cm.occ.cells) != OCCUPIED, cm.spec)
+        cells = fill_gaps(cm.occ.cells)
+        labels = segment_rooms(cells != OCCUPIED, cm.spec)
+        inside = labels >= 0
+        if inside.any():
+            k = labels[inside]
+            seen = np.bincount(k, weights=(cells[inside] == FREE).astype(np.float64))
+            unseen = seen < 0.5 * np.bincount(k)
+            labels = np.where(inside & unseen[np.maximum(labels, 0)], -1, labels).astype(np.int32)
         cm.cache["rooms"] = labels
     return np.asarray(labels)
 
