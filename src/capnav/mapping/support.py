@@ -30,7 +30,8 @@ from scipy import ndimage
 from scipy.spatial import Delaunay, QhullError
 
 from capnav.core.geometry import Intrinsics
-from capnav.perception.box_masks import depth_jumps, up_facing_pixels
+from capnav.perception.box_masks import up_facing_pixels
+from capnav.perception.depth_edges import depth_jumps
 
 _EIGHT = np.ones((3, 3), dtype=bool)
 

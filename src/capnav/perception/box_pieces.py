@@ -4,7 +4,7 @@ A mask from a box (``box_masks``) holds what the image shows inside it, and thro
 open-frame chair, under a table or past a tight box's edge the image shows other things: a
 window frame behind the chair, the side of the cabinet beside it, a wall a metre behind. In the
 image they touch the object; in 3D they are apart from it. ``linked_pieces`` cuts the mask into
-smooth pieces at depth jumps (``box_masks.depth_jumps``), takes the largest piece as the
+smooth pieces at depth jumps (``depth_edges.depth_jumps``), takes the largest piece as the
 object's core and adds, again and again, every piece that comes within ``link`` of what is
 kept (single linkage in 3D). The parts of one object are joined in the world (a leg under its
 seat, an arm over the seat, a backrest on its posts), so their seen points come close to each
@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
-from capnav.perception.box_masks import attach_to_nearest, depth_jumps
+from capnav.perception.depth_edges import attach_to_nearest, depth_jumps
 
 
 @dataclass(frozen=True)
