@@ -101,3 +101,14 @@ def orbit(n: int = 60, radius: float = 1.2, width: int = 160, height: int = 120,
         T = look_at_pose(eye, yaw=a + 0.3, pitch=np.deg2rad(20))
         frames.append(render(boxes, T, K, index=i))
     return frames
+
+
+def look_at(eye: tuple[float, float, float], target: tuple[float, float, float]) -> np.ndarray:
+    """Camera-to-world pose (z forward, x right, y down) of a camera at ``eye`` looking at ``target``."""
+    e, t = np.array(eye, dtype=float), np.array(target, dtype=float)
+    f = (t - e) / np.linalg.norm(t - e)
+    r = np.cross(f, [0.0, 0.0, 1.0])
+    r /= np.linalg.norm(r)
+    T = np.eye(4)
+    T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3] = r, np.cross(f, r), f, e
+    return T

@@ -5,7 +5,7 @@ weigh 3D support, not box counts; a bowl on a desk stands on it (never merged in
 from __future__ import annotations
 
 import numpy as np
-from _synth_scene import Box, render
+from _synth_scene import Box, look_at, render
 
 from capnav.core.geometry import Intrinsics
 from capnav.mapping.support import cut_at_support, stands_on
@@ -13,16 +13,6 @@ from capnav.mapping.tracker import Track, vote_all
 from capnav.perception import Detection, box_from_mask
 
 K = Intrinsics.from_fov(320, 240, 70.0)
-
-
-def _look(eye: tuple[float, float, float], target: tuple[float, float, float]) -> np.ndarray:
-    e, t = np.array(eye, dtype=float), np.array(target, dtype=float)
-    f = (t - e) / np.linalg.norm(t - e)
-    r = np.cross(f, [0.0, 0.0, 1.0])
-    r /= np.linalg.norm(r)
-    T = np.eye(4)
-    T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3] = r, np.cross(f, r), f, e
-    return T
 
 
 def _table_with_cup() -> list[Box]:
@@ -47,7 +37,7 @@ def _cut(frame, ids: set[int], thing: bool, box_of: set[int] | None = None) -> t
 
 
 def test_a_cup_box_keeps_the_cup_and_a_table_box_sheds_it() -> None:
-    f = render(_table_with_cup(), _look((1.6, -1.2, 1.3), (0.0, 0.0, 0.75)), K)
+    f = render(_table_with_cup(), look_at((1.6, -1.2, 1.3), (0.0, 0.0, 0.75)), K)
     inst = f.gt_instance
     assert inst is not None and (inst == 2).sum() > 30
     # The cup's box also shows the table top around it: the cup is what stands on the plane.
@@ -65,12 +55,12 @@ def test_a_chair_keeps_its_backrest_and_a_tv_keeps_itself() -> None:
     chair += [Box((x - 0.02, y - 0.02, 0.0), (x + 0.02, y + 0.02, 0.42), 1, 3, (90, 60, 40))
               for x in (-0.2, 0.2) for y in (-0.2, 0.2)]
     chair.append(Box((-0.22, 0.18, 0.47), (0.22, 0.22, 0.92), 1, 3, (90, 60, 40)))  # backrest on the back legs
-    f = render(chair, _look((1.3, -1.5, 1.25), (0.0, 0.0, 0.5)), K)
+    f = render(chair, look_at((1.3, -1.5, 1.25), (0.0, 0.0, 0.5)), K)
     mask, cut = _cut(f, {1}, thing=False)
     assert mask.sum() > 200 and (cut == mask).all()
     tv = [Box((-0.6, -0.2, 0.0), (0.6, 0.2, 0.5), 1, 12, (60, 40, 30)),
           Box((-0.45, -0.05, 0.5), (0.45, 0.0, 1.0), 2, 14, (20, 20, 20))]
-    f = render(tv, _look((0.3, -2.0, 1.25), (0.0, 0.0, 0.6)), K)
+    f = render(tv, look_at((0.3, -2.0, 1.25), (0.0, 0.0, 0.6)), K)
     inst = f.gt_instance
     mask, cut = _cut(f, {1, 2}, thing=False, box_of={2})  # the TV's box with the cabinet top in it
     assert cut[mask & (inst == 2)].all()

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from _synth_scene import Box, render
+from _synth_scene import Box, look_at, render
 
 from capnav.core.geometry import Intrinsics
 from capnav.perception import box_from_mask
@@ -20,21 +20,11 @@ SOFA = [Box((-1.0, 2.1, 0.1), (1.0, 2.9, 0.45), 1, 1, RED), Box((-1.0, 2.7, 0.45
         Box((-1.0, 2.15, 0.0), (1.0, 2.25, 0.1), 1, 1, RED)]
 
 
-def _look(eye: tuple[float, float, float], target: tuple[float, float, float]) -> np.ndarray:
-    e, t = np.array(eye, dtype=float), np.array(target, dtype=float)
-    f = (t - e) / np.linalg.norm(t - e)
-    r = np.cross(f, [0.0, 0.0, 1.0])
-    r /= np.linalg.norm(r)
-    T = np.eye(4)
-    T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3] = r, np.cross(f, r), f, e
-    return T
-
-
 def _mask(eye: tuple[float, float, float], target: tuple[float, float, float], margin: float = 6.0
           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The sofa's depth mask from a detector's box: the true box grown 3%, but never closer than
     ``margin`` px to the image border (a detector's box of a cut-off object stops short of it)."""
-    f = render(SOFA, _look(eye, target), K)
+    f = render(SOFA, look_at(eye, target), K)
     inst = np.asarray(f.gt_instance) == 1
     x0, y0, x1, y1 = box_from_mask(inst)
     g = 0.03 * (x1 - x0)

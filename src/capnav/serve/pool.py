@@ -38,7 +38,39 @@ class Overtime(CapNavError):
 _STOP = object()
 
 
-class WorkPool(Generic[S]):
+class PoolCounters:
+    """What both pools (threads here, processes in ``procpool``) say about themselves the same
+    way: readiness, the load error, jobs in flight; each sets ``_ready``, ``_load_error`` and
+    ``_admitted``."""
+
+    workers: int
+    capacity: int
+    _admitted: int
+    _ready: threading.Event
+    _load_error: BaseException | None
+
+    @property
+    def ready(self) -> bool:
+        """Every worker has made its state (maps opened, embedder loaded)."""
+        return self._ready.is_set() and self._load_error is None
+
+    @property
+    def load_error(self) -> BaseException | None:
+        return self._load_error
+
+    def wait_ready(self, timeout: float | None = None) -> bool:
+        self._ready.wait(timeout)
+        if self._load_error is not None:
+            raise self._load_error
+        return self._ready.is_set()
+
+    @property
+    def in_flight(self) -> int:
+        """Jobs admitted and not finished (running or waiting)."""
+        return self._admitted
+
+
+class WorkPool(PoolCounters, Generic[S]):
     """``workers`` threads, each with the state ``make_state(i)`` made in that thread at start."""
 
     def __init__(self, workers: int, queue_size: int, make_state: Callable[[int], S], name: str = "capnav-worker"
@@ -64,26 +96,6 @@ class WorkPool(Generic[S]):
             self._started = True
             for t in self._threads:
                 t.start()
-
-    @property
-    def ready(self) -> bool:
-        """Every worker has made its state (maps opened, embedder loaded)."""
-        return self._ready.is_set() and self._load_error is None
-
-    @property
-    def load_error(self) -> BaseException | None:
-        return self._load_error
-
-    def wait_ready(self, timeout: float | None = None) -> bool:
-        self._ready.wait(timeout)
-        if self._load_error is not None:
-            raise self._load_error
-        return self._ready.is_set()
-
-    @property
-    def in_flight(self) -> int:
-        """Jobs admitted and not finished (running or waiting)."""
-        return self._admitted
 
     def close(self, timeout: float = 30.0) -> None:
         """Let admitted jobs finish, then stop the threads (SIGTERM's drain)."""

@@ -36,7 +36,7 @@ from collections.abc import Callable
 from typing import Any
 
 from capnav.core.errors import CapNavError
-from capnav.serve.pool import Busy, Overtime
+from capnav.serve.pool import Busy, Overtime, PoolCounters
 
 log = logging.getLogger("capnav.serve")
 _STOP = "stop"
@@ -98,7 +98,7 @@ class _Worker:
         self.job: int | None = None  # the job it runs, None when idle
 
 
-class ProcessPool:
+class ProcessPool(PoolCounters):
     """``workers`` processes, each with the state ``make_state(i)`` made in it; the face of
     ``WorkPool`` (``start``, ``ready``, ``run``, ``close``, ...)."""
 
@@ -134,26 +134,6 @@ class ProcessPool:
             self._procs = [self._spawn(i) for i in range(self.workers)]
             self._reader = threading.Thread(target=self._read, name="capnav-results", daemon=True)
             self._reader.start()
-
-    @property
-    def ready(self) -> bool:
-        """Every worker has made its state (maps opened, embedder loaded)."""
-        return self._ready.is_set() and self._load_error is None
-
-    @property
-    def load_error(self) -> BaseException | None:
-        return self._load_error
-
-    def wait_ready(self, timeout: float | None = None) -> bool:
-        self._ready.wait(timeout)
-        if self._load_error is not None:
-            raise self._load_error
-        return self._ready.is_set()
-
-    @property
-    def in_flight(self) -> int:
-        """Jobs admitted and not finished (running or waiting)."""
-        return self._admitted
 
     @property
     def pids(self) -> list[int]:
