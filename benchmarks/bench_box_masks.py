@@ -12,7 +12,7 @@ Truth is read here only (evaluation).
 1. Per view (every ``--view-stride``-th frame, instances showing >= 0.2% of the image): IoU of
    the mask with the true instance mask, and the share of mask pixels that are not the instance
    (what the mask took in from the wall, floor or neighbours), for ``method="mode"`` (the
-   nearest strong depth mode grown along smooth depth, before issue 11) and ``"surfaces"``.
+   nearest strong depth mode grown along smooth depth, the first method) and ``"surfaces"``.
 2. Per map: the whole pass mapped with those masks (labels from the truth, every
    ``--map-stride``-th frame), objects matched to instances by ``capnav.eval.map_quality``, and
    the size error of each matched instance's object (``map_quality.size_error``: the larger of the

@@ -7,7 +7,7 @@ process on a 300-object map.
    and written three ways: as version 2 wrote it (float32 features, arrays stored uncompressed:
    the sum of its entries), version 3 with ``feature_dtype="float32"`` (deflate only, features
    bit for bit) and version 3's default (float16 features + deflate). Load time is the smallest
-   process CPU time of ``--repeat`` loads. Target (issue 16): <= 0.5x version 2's size.
+   process CPU time of ``--repeat`` loads. Target: <= 0.5x version 2's size.
 2. The consequence of float16: CapNav's retrieval reads objects (captions, embeddings, points),
    never voxel features, so its answers cannot change (checked: every object array equal). The
    VLMaps-style baseline reads them: its top-down segmentation (every cell classified against the

@@ -7,11 +7,11 @@
 2. Voxel fusion in points/s on the same back-projected points: CapNav's eq. 5-8 fusion (64-dim
    features + colour + weight, incremental) side by side with Open3D's ``voxel_down_sample``
    (colour + position only, one batch call), min CPU time of 3 runs each, with the ratio beside
-   issue 16's targets. Open3D's voxels differ in number: it puts the grid origin at the cloud's
+   the project's targets. Open3D's voxels differ in number: it puts the grid origin at the cloud's
    minimum corner, ours at eq. 4's fixed origin. Skipped with a message if open3d is not installed.
 3. Peak memory while mapping a whole apartment (tracemalloc peak of Python/numpy allocations, and
    the process's max RSS), and the size of the map.
-4. Mapping quality on each seed's apartment at the given detector noise vs issue #3's targets.
+4. Mapping quality on each seed's apartment at the given detector noise vs the project's mapping targets.
 """
 
 from __future__ import annotations
@@ -160,7 +160,7 @@ def _best_cpu(fn: Callable[[], object], repeat: int) -> tuple[float, object]:
 
 def fusion_vs_open3d(frames: list, repeat: int = 3) -> list[list[str]]:
     """Both on the same back-projected points of every frame, 5 cm voxels, one thread, min CPU
-    time of ``repeat`` runs. Targets (issue 16): colour at >= 1x Open3D's rate, 64-d >= 0.5x."""
+    time of ``repeat`` runs. Targets: colour at >= 1x Open3D's rate, 64-d >= 0.5x."""
     from capnav.core.geometry import backproject
     from capnav.mapping import VoxelConfig, VoxelMap
 

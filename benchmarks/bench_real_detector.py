@@ -9,7 +9,7 @@ the ``sim`` detector (default noise, seed 0). Everything runs on one thread (num
 onnxruntime and OpenCV limited to 1). Stages, CPU milliseconds per frame (``process_time``, so
 a busy shared machine does not inflate them): the detector model (resize, inference, decoding,
 NMS), its depth masks, the dense encoder + voxel fusion, and lifting + tracking + memory. The
-target of issue 11 is >= 5 frames/s on one core including the detector.
+target is >= 5 frames/s on one core including the detector.
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ Retrieval is not involved: this measures goal selection, A* and execution only.
     .venv/bin/python benchmarks/eval_reach.py [--seeds 0 1 2] [--starts 3] [--seed 0]
         [--occupancy truth mapped] [--map-cache DIR]
 
-Targets (issue 5): >= 99% with the true occupancy, >= 95% with the mapped one.
+Targets: >= 99% with the true occupancy, >= 95% with the mapped one.
 """
 
 from __future__ import annotations

@@ -54,7 +54,7 @@ class MappingQuality:
     unmatched_objects: list[dict[str, Any]] = field(default_factory=list)
 
     def rows(self) -> list[tuple[str, str, str]]:
-        """(metric, value, target) rows for a table; targets are issue #3's acceptance levels."""
+        """(metric, value, target) rows for a table; targets are the project's acceptance levels for mapping."""
         iou = "n/a" if self.occupancy_iou is None else f"{self.occupancy_iou:.3f}"
         return [
             ("objects in map", str(self.n_objects), ""),

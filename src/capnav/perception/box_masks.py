@@ -8,7 +8,7 @@ background ones: those that run on out of the box on two sides (walls, a far roo
 seen only through the object (the wall between chair slats, under a table); of the rest, the
 group of touching surfaces that fills the box and is least hidden is the object. The floor
 touches every object's base smoothly, so it is excluded first when the camera pose is known
-(``floor_pixels``). ``method="mode"`` (the method before issue 11, and the fallback when no
+(``floor_pixels``). ``method="mode"`` (the first method, and the fallback when no
 surface qualifies) finds the strong depth modes inside the box (``band``-wide depth slabs
 holding at least ``min_mode_frac`` of the strongest slab's pixels), takes the pixels within
 ``band / 2`` of the nearest one and their largest 8-connected component, and grows that along
