@@ -46,7 +46,8 @@ def test_facing_is_the_heading_inside_the_angle_the_object_spans() -> None:
     a heading 90 degrees off its nearest corner does not (and says by how much)."""
     import numpy as np
 
-    from capnav.demo.run import _off_facing_deg, _room_of
+    from capnav.demo.run import _off_facing_deg
+    from capnav.sim.success import room_index
 
     sofa = np.array([[1.0, -1.0], [1.8, -1.0], [1.8, 1.0], [1.0, 1.0]])
     assert _off_facing_deg((0.0, 0.0, 0.0), sofa) == 0.0  # straight at it
@@ -57,7 +58,7 @@ def test_facing_is_the_heading_inside_the_angle_the_object_spans() -> None:
     assert off == pytest.approx(45.0)  # 45 degrees past the corner at (1, 1)
     rooms = [np.array([[0.0, 0.0], [3.0, 0.0], [3.0, 3.0], [0.0, 3.0]]),
              np.array([[3.1, 0.0], [6.0, 0.0], [6.0, 3.0], [3.1, 3.0]])]
-    assert [_room_of(p, rooms) for p in ((1.0, 1.0), (4.0, 1.0), (3.05, 1.0))] == [0, 1, -1]
+    assert [room_index(p, rooms) for p in ((1.0, 1.0), (4.0, 1.0), (3.05, 1.0))] == [0, 1, -1]
 
 
 def test_demo_user_instruction_that_matches_nothing_or_is_rejected(tmp_path: Path) -> None:

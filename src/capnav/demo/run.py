@@ -34,7 +34,7 @@ from capnav.retrieval import RetrievalConfig, Retriever, create_verifier
 from capnav.sim.geodesic import walker
 from capnav.sim.instructions import Walk, generate_instructions
 from capnav.sim.navgrid import start_cells
-from capnav.sim.success import SUCCESS_RADIUS_M, distance_to_instances
+from capnav.sim.success import SUCCESS_RADIUS_M, distance_to_instances, room_index
 
 #: One instruction of each kind by default: what CapNav is for first, then the classic cases.
 DEFAULT_KINDS = ("attribute", "superlative", "relation", "closest", "room", "category", "absent")
@@ -72,12 +72,6 @@ def _png(obj: MapObject) -> bytes | None:
         if v.frame_png:
             return v.frame_png
     return None
-
-
-def _room_of(xy: Any, rooms: list[NDArray[np.float64]]) -> int:
-    """Index of the true room polygon holding ``xy`` (-1: in none, e.g. a doorway)."""
-    p = np.asarray(xy, dtype=np.float64).reshape(1, 2)
-    return next((k for k, poly in enumerate(rooms) if footprint_distance(p, poly)[0] == 0.0), -1)
 
 
 def _off_facing_deg(pose: tuple[float, float, float], footprint: NDArray[np.float64]) -> float:
@@ -216,7 +210,7 @@ def _answer(k: int, text: str, kind: str, targets: list[int], retriever: Retriev
         if nav is not None:
             item.truth_distance = distance_to_instances(nav.final_pose[:2], fps)
             meant = fps[int(np.argmin([distance_to_instances(nav.final_pose[:2], [f]) for f in fps]))]
-            item.in_room = _room_of(nav.final_pose[:2], rooms) == _room_of(meant.mean(axis=0), rooms) >= 0
+            item.in_room = room_index(nav.final_pose[:2], rooms) == room_index(meant.mean(axis=0), rooms) >= 0
             item.facing_deg = _off_facing_deg(nav.final_pose, meant)
         item.correct = item.truth_distance is not None and item.truth_distance <= SUCCESS_RADIUS_M
     if obj is not None and (view := _png(obj)):

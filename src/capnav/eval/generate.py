@@ -21,7 +21,7 @@ from capnav.core.grid import GridSpec
 from capnav.eval.episodes import Episode, StartPose, Subgoal
 from capnav.sim.geodesic import DistanceField, distance_field
 from capnav.sim.sightline import SightGrid
-from capnav.sim.success import SUCCESS_RADIUS_M
+from capnav.sim.success import SUCCESS_RADIUS_M, room_index
 
 
 @dataclass(frozen=True)
@@ -80,11 +80,7 @@ class SceneTruth:
 
     def room_of(self, xy: Sequence[float] | NDArray[np.floating]) -> int:
         """Index of the room polygon holding ``xy`` (-1 outside every room or without rooms)."""
-        p = np.asarray(xy, dtype=np.float64).reshape(1, 2)
-        for k, poly in enumerate(self.rooms or []):
-            if footprint_distance(p, poly)[0] == 0.0:
-                return k
-        return -1
+        return room_index(xy, self.rooms or [])
 
     def in_goal_room(self, xy: tuple[float, float], target_ids: Sequence[int]) -> bool | None:
         """The strict rule with the room: a goal instance within ``radius``, in sight, and in the

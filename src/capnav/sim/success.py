@@ -28,3 +28,10 @@ def distance_to_instances(xy: Sequence[float] | NDArray[np.floating],
 def is_success(xy: Sequence[float] | NDArray[np.floating], footprints: Sequence[NDArray[np.floating]],
                radius: float = SUCCESS_RADIUS_M) -> bool:
     return distance_to_instances(xy, footprints) <= radius
+
+
+def room_index(xy: Sequence[float] | NDArray[np.floating], rooms: Sequence[NDArray[np.floating]]) -> int:
+    """Index of the room polygon holding ``xy`` (-1 in none, e.g. a doorway, or without rooms): the
+    "in the object's room" rule of the benchmark and the demo."""
+    p = np.asarray(xy, dtype=np.float64).reshape(1, 2)
+    return next((k for k, poly in enumerate(rooms) if footprint_distance(p, np.asarray(poly))[0] == 0.0), -1)
