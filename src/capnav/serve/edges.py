@@ -111,7 +111,10 @@ class BearerToken:
 
 
 class AccessLog:
-    """One line per request: method, path, status, milliseconds (``capnav serve --access-log``)."""
+    """One line per request: method, path, status, milliseconds (``capnav serve --access-log``).
+
+    The line is written before the last body chunk goes out, so a client that has its answer can
+    already read the line (written after, it raced the client's next step)."""
 
     def __init__(self, app: ASGIApp) -> None:
         self.app = app
@@ -122,14 +125,22 @@ class AccessLog:
             return
         t0 = time.perf_counter()
         status: list[Any] = [None]
+        logged = [False]
+
+        def line() -> None:
+            if not logged[0]:
+                logged[0] = True
+                access.info("%s %s %s %.1f ms %s", scope.get("method"), scope.get("path"), status[0] or "-",
+                            1e3 * (time.perf_counter() - t0), _who(scope))
 
         async def seen(m: Message) -> None:
             if m["type"] == "http.response.start":
                 status[0] = m["status"]
+            elif m["type"] == "http.response.body" and not m.get("more_body", False):
+                line()
             await send(m)
 
         try:
             await self.app(scope, receive, seen)
         finally:
-            access.info("%s %s %s %.1f ms %s", scope.get("method"), scope.get("path"), status[0] or "-",
-                        1e3 * (time.perf_counter() - t0), _who(scope))
+            line()
