@@ -117,3 +117,40 @@ def test_the_cache_keeps_the_most_recently_used_sources() -> None:
     assert floor.from_point((1.0, 1.0)) is a  # used again: now the most recent
     floor.from_point((0.2, 1.8))  # evicts (1.5, 1.5), the least recently used
     assert floor.from_point((1.0, 1.0)) is a
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_floor_distances_give_the_floats_of_the_heap_dijkstra_and_the_per_box_loop(seed: int) -> None:
+    # The fused kernel (walk on the padded grid made once per map, minima over the boxes without the
+    # whole field) against the replaced routine, from many sources, with boxes partly off the grid
+    # and boxes in the closed-off pocket (measured at their grown ring, or not at all).
+    rng = np.random.default_rng(10 + seed)
+    spec = GridSpec(0.0, 0.0, 0.1, 30, 45)
+    dom = rooms_with_doors(rng, 30, 45)
+    dom[18:27, 30:39] = False  # a closed room: its walls, and inside them
+    dom[19:26, 31:38] = True
+    occ = OccupancyGrid(spec, np.where(dom, FREE, OCCUPIED).astype(np.uint8))
+    los = rng.uniform([-0.4, -0.4], [4.4, 2.9], (40, 2))
+    his = los + rng.uniform(0.05, 0.6, (40, 2))
+    inner = spec.to_world(np.array([[20, 32], [21, 34]]))  # in the closed room, within RING of its walls
+    los[-3:] = [inner.min(axis=0), spec.to_world(np.array([22, 35])), [-3.0, -3.0]]  # the last: off the grid
+    his[-3:] = [inner.max(axis=0), spec.to_world(np.array([24, 36])), [-2.0, -2.0]]
+    floor = FloorDistances(occ, los, his, cache_size=1)
+    free = np.argwhere(floor.domain)
+    finite, ring = 0, 0
+    for r, c in free[rng.choice(len(free), size=6, replace=False)]:
+        xy = spec.to_world(np.array([r, c]))
+        got = floor.from_point((float(xy[0]), float(xy[1])))
+        field = heap_dijkstra(floor.domain, np.array([spec.to_cell(xy)], np.int64), math.inf) * spec.resolution
+        ref = np.array([box_min(field, spec, lo, hi, RING) for lo, hi in zip(los, his, strict=True)])
+        np.testing.assert_array_equal(got, ref)
+        finite += int(np.isfinite(ref).sum())
+        ring += int(np.isfinite(ref[-3]))
+    pair = np.array([0, 3])
+    field = heap_dijkstra(floor.domain, np.concatenate(
+        [np.argwhere(np.ones((b[2] - b[0] + 1, b[3] - b[1] + 1), bool)) + b[:2]
+         for b in (np.array(box_cells(spec, los[i], his[i])) for i in pair)
+         if b[2] >= b[0] and b[3] >= b[1]]).astype(np.int64), math.inf) * spec.resolution
+    ref = np.array([box_min(field, spec, lo, hi, RING) for lo, hi in zip(los, his, strict=True)])
+    np.testing.assert_array_equal(floor.from_objects(pair), ref)
+    assert 0 < finite < 6 * len(los) and ring > 0  # unreached boxes, and one measured at its ring

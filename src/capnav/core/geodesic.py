@@ -7,7 +7,15 @@ buckets before k are done (Dinitz's observation). The cells of one bucket are th
 any order, each once, with no heap: a whole-grid search costs a few array reads per cell. The
 values are the same floats a heap-ordered Dijkstra gives (each cell keeps the smallest
 ``d(neighbour) + step`` over its expanded neighbours, and rounding is monotone), so answers do
-not move. Both kernels release the GIL: searches of several server threads run side by side.
+not move.
+
+Why one array: the distances live on the grid padded by a border, with ``BLOCKED`` (-1) in
+unwalkable and border cells, so a neighbour is tested with the one read ``d + step < dist[v]``
+(false for a blocked cell, and for an expanded one: its distance is below any step from the
+bucket being expanded). A cell's entry in bucket k is stale when its distance has since dropped
+below k (it was expanded from an earlier bucket). The padded grid of a domain
+(:func:`walk_base`) is made once per map and copied per search. Every kernel releases the GIL:
+searches of several server threads run side by side.
 """
 
 from __future__ import annotations
@@ -20,33 +28,40 @@ _DR = np.array([-1, -1, -1, 0, 0, 1, 1, 1], dtype=np.int64)
 _DC = np.array([-1, 0, 1, -1, 1, -1, 0, 1], dtype=np.int64)
 _STEP = np.array([1.4142135623730951, 1.0, 1.4142135623730951, 1.0, 1.0, 1.4142135623730951, 1.0,
                   1.4142135623730951])
+#: The padded distance of a cell no walk enters (below every distance, so never "improved").
+BLOCKED = -1.0
 
 
 @njit(cache=True, nogil=True)
-def grid_geodesic(domain: NDArray[np.bool_], seeds: NDArray[np.int64], limit: float) -> NDArray[np.float64]:
-    """Cells (float) from the nearest seed (row, col) to every cell through ``domain`` (True =
-    walkable); inf where no walk reaches. Cells farther than ``limit`` are not expanded (a cell
-    just past it keeps the value its expanded neighbours give it)."""
+def walk_base(domain: NDArray[np.bool_]) -> NDArray[np.float64]:
+    """The padded, flattened start of a search on ``domain`` (True = walkable): inf on walkable
+    cells, ``BLOCKED`` on the others and on a one-cell border (no bounds checks in the search)."""
     rows, cols = domain.shape
-    w = cols + 2  # a border of unwalkable cells: no bounds checks in the loop
-    n = (rows + 2) * w
-    # One byte per cell: 0 not walkable (or the border), 1 walkable, 2 expanded (final).
-    state = np.zeros(n, np.uint8)
+    w = cols + 2
+    base = np.full((rows + 2) * w, BLOCKED)
     for r in range(rows):
+        o = (r + 1) * w + 1
         for c in range(cols):
             if domain[r, c]:
-                state[(r + 1) * w + c + 1] = 1
+                base[o + c] = np.inf
+    return base
+
+
+@njit(cache=True, nogil=True)
+def _walk(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int64], limit: float) -> NDArray[np.float64]:
+    """Cells from the nearest seed, on a copy of ``base`` (padded, ``cols`` + 2 wide)."""
+    w = cols + 2
+    dist = base.copy()
     off = np.empty(8, np.int64)
     for m in range(8):
         off[m] = _DR[m] * w + _DC[m]
-    dist = np.full(n, np.inf)
-    # Three buckets suffice: a cell expanded from bucket k lands in k + 1 or k + 2 (steps < 2).
-    cap = 2 * rows * cols + seeds.shape[0] + 1
-    buckets = np.empty((3, cap), np.int32)
+    # Three buckets suffice: a cell expanded from bucket k lands in k + 1 or k + 2 (steps < 2); a
+    # bucket holds a cell at most once.
+    buckets = np.empty((3, base.shape[0] + seeds.shape[0] + 1), np.int32)
     fill = np.zeros(3, np.int64)
     for i in range(seeds.shape[0]):
         u = (seeds[i, 0] + 1) * w + seeds[i, 1] + 1
-        if dist[u] > 0.0:
+        if dist[u] != 0.0:  # a seed starts the walk even where the domain is not walkable
             dist[u] = 0.0
             buckets[0, fill[0]] = u
             fill[0] += 1
@@ -58,16 +73,11 @@ def grid_geodesic(domain: NDArray[np.bool_], seeds: NDArray[np.int64], limit: fl
         while j < fill[b]:
             u = buckets[b, j]
             j += 1
-            if state[u] == 2:
-                continue
-            state[u] = 2
             du = dist[u]
-            if du > limit:
+            if int(du) != k or du > limit:  # stale (expanded from an earlier bucket), or too far
                 continue
             for m in range(8):
                 v = u + off[m]
-                if state[v] != 1:
-                    continue
                 nd = du + _STEP[m]
                 dv = dist[v]
                 if nd < dv:
@@ -80,10 +90,55 @@ def grid_geodesic(domain: NDArray[np.bool_], seeds: NDArray[np.int64], limit: fl
         pending -= fill[b]
         fill[b] = 0
         k += 1
+    return dist
+
+
+@njit(cache=True, nogil=True)
+def grid_geodesic(domain: NDArray[np.bool_], seeds: NDArray[np.int64], limit: float) -> NDArray[np.float64]:
+    """Cells (float) from the nearest seed (row, col) to every cell through ``domain`` (True =
+    walkable); inf where no walk reaches. Cells farther than ``limit`` are not expanded (a cell
+    just past it keeps the value its expanded neighbours give it)."""
+    rows, cols = domain.shape
+    dist = _walk(walk_base(domain), cols, seeds, limit)
     out = np.empty((rows, cols))
+    w = cols + 2
     for r in range(rows):
+        o = (r + 1) * w + 1
         for c in range(cols):
-            out[r, c] = dist[(r + 1) * w + c + 1]
+            d = dist[o + c]
+            out[r, c] = d if d >= 0.0 else np.inf
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _padded_min(dist: NDArray[np.float64], w: int, bx: NDArray[np.int64]) -> float:
+    best = np.inf
+    for r in range(bx[0], bx[2] + 1):
+        o = (r + 1) * w + 1
+        for c in range(bx[1], bx[3] + 1):
+            d = dist[o + c]
+            if d >= 0.0 and d < best:
+                best = d
+    return best
+
+
+@njit(cache=True, nogil=True)
+def walk_box_minima(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int64], boxes: NDArray[np.int64],
+                    grown: NDArray[np.int64], scale: float, grow: float) -> NDArray[np.float64]:
+    """``box_minima`` of the walk from ``seeds`` on ``base`` (:func:`walk_base` of a grid ``cols``
+    wide) times ``scale``, without making the (rows, cols) field: the same floats, since scaling by
+    a positive number keeps the minimum (rounding is monotone)."""
+    dist = _walk(base, cols, seeds, np.inf)
+    w = cols + 2
+    out = np.full(boxes.shape[0], np.inf)
+    for i in range(boxes.shape[0]):
+        best = _padded_min(dist, w, boxes[i])
+        if best < np.inf:
+            out[i] = best * scale
+            continue
+        best = _padded_min(dist, w, grown[i])
+        if best < np.inf:
+            out[i] = best * scale + grow
     return out
 
 
@@ -107,4 +162,4 @@ def box_minima(field: NDArray[np.float64], boxes: NDArray[np.int64], grown: NDAr
     return out
 
 
-__all__ = ["box_minima", "grid_geodesic"]
+__all__ = ["BLOCKED", "box_minima", "grid_geodesic", "walk_base", "walk_box_minima"]

@@ -57,10 +57,9 @@ def walkable_domain(occ: OccupancyGrid, boxes_lo: NDArray[np.float64], boxes_hi:
     return dom
 
 
-def geodesic_from_boxes(domain: NDArray[np.bool_], spec: GridSpec, los: NDArray[np.floating],
-                        his: NDArray[np.floating], limit_m: float = 12.0) -> NDArray[np.float64]:
-    """Metres from the nearest of several boxes to every cell through ``domain`` (inf where
-    unreachable or beyond ``limit_m``): one multi-source Dijkstra."""
+def box_seeds(domain: NDArray[np.bool_], spec: GridSpec, los: NDArray[np.floating], his: NDArray[np.floating]
+              ) -> NDArray[np.int64]:
+    """The walkable cells (K, 2) row, col of several boxes: where a walk from them starts."""
     seeds_list = []
     for lo, hi in zip(np.atleast_2d(los), np.atleast_2d(his), strict=True):
         r0, c0, r1, c1 = box_cells(spec, lo, hi)
@@ -69,9 +68,16 @@ def geodesic_from_boxes(domain: NDArray[np.bool_], spec: GridSpec, los: NDArray[
         rr, cc = np.mgrid[r0:r1 + 1, c0:c1 + 1]
         seeds_list.append(np.stack([rr.ravel(), cc.ravel()], axis=1))
     if not seeds_list:
-        return np.full(domain.shape, np.inf)
+        return np.empty((0, 2), np.int64)
     seeds = np.concatenate(seeds_list).astype(np.int64)
-    seeds = seeds[domain[seeds[:, 0], seeds[:, 1]]]
+    return seeds[domain[seeds[:, 0], seeds[:, 1]]]
+
+
+def geodesic_from_boxes(domain: NDArray[np.bool_], spec: GridSpec, los: NDArray[np.floating],
+                        his: NDArray[np.floating], limit_m: float = 12.0) -> NDArray[np.float64]:
+    """Metres from the nearest of several boxes to every cell through ``domain`` (inf where
+    unreachable or beyond ``limit_m``): one multi-source Dijkstra."""
+    seeds = box_seeds(domain, spec, los, his)
     if len(seeds) == 0:
         return np.full(domain.shape, np.inf)
     return grid_geodesic(domain, seeds, limit_m / spec.resolution) * spec.resolution

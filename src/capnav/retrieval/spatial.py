@@ -14,9 +14,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from capnav.core.geodesic import box_minima
+from capnav.core.geodesic import walk_base, walk_box_minima
 from capnav.core.grid import OCCUPIED, OccupancyGrid
-from capnav.language.rooms import box_cells, fill_gaps, geodesic_from_boxes
+from capnav.language.rooms import box_cells, box_seeds, fill_gaps
 
 #: Below this length / width ratio a footprint has no long axis, so no "end" (a round or square
 #: table): "at the end of" is then read as "next to".
@@ -96,6 +96,7 @@ class FloorDistances:
             (r0, c0), (r1, c1) = self.spec.to_cell(lo), self.spec.to_cell(hi)
             dom[max(r0, 0):max(r1 + 1, 0), max(c0, 0):max(c1 + 1, 0)] = True
         self.domain = dom
+        self._base = walk_base(dom)  # the padded start of every search, copied per source
         # Each object's cells and its cells grown by RING, once per map (read by every search).
         self._boxes = np.array([box_cells(self.spec, lo, hi) for lo, hi in zip(self.los, self.his, strict=True)],
                                dtype=np.int64).reshape(-1, 4)
@@ -108,8 +109,12 @@ class FloorDistances:
                     ) -> NDArray[np.float64]:
         hit = self._cache.pop(key, None)
         if hit is None:
-            field = geodesic_from_boxes(self.domain, self.spec, los, his, limit_m=np.inf)
-            hit = box_minima(field, self._boxes, self._grown, RING)
+            seeds = box_seeds(self.domain, self.spec, los, his)
+            if len(seeds) == 0:
+                hit = np.full(len(self._boxes), np.inf)
+            else:
+                hit = walk_box_minima(self._base, self.spec.cols, seeds, self._boxes, self._grown,
+                                      self.spec.resolution, RING)
             if len(self._cache) >= self._size:
                 self._cache.pop(next(iter(self._cache)))  # the least recently used source
         self._cache[key] = hit
