@@ -98,6 +98,7 @@ def mark_blocked(costmap: Costmap, xy: NDArray[np.floating], radius: float, conf
     win = costmap.weights[r0:r1, c0:c1]
     newly = (d <= reach) & np.isfinite(win) & ~keep
     win[newly] = np.inf
+    costmap.cache.pop("goal_around", None)  # goal selection's per-object windows read the cells marked here
     return int(newly.sum())
 
 

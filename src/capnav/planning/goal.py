@@ -91,6 +91,84 @@ def room_labels(cm: Costmap) -> NDArray[np.int32]:
     return np.asarray(labels)
 
 
+#: Objects whose goal setup (``_Around``, tens of kB each) a costmap keeps: the most recently asked.
+AROUND_CACHE = 256
+
+
+@dataclass(frozen=True)
+class _Around:
+    """What goal selection needs of one object on one costmap, wherever the robot stands: the
+    window of cells that can be within reach (``lo``..``hi``), their distances to the footprint,
+    which stand on seen free floor where goals may be, which lie in the object's room, and the
+    sight test. The weights are read per search (``mark_blocked`` raises them in place)."""
+
+    lo: NDArray[np.intp]
+    hi: NDArray[np.intp]
+    dist: NDArray[np.float64]
+    seen: NDArray[np.bool_]  # FREE on the map, and allowed
+    in_room: NDArray[np.bool_]
+    region: int
+    sight: SightTest | None
+
+    @property
+    def win(self) -> tuple[slice, slice]:
+        return slice(int(self.lo[0]), int(self.hi[0]) + 1), slice(int(self.lo[1]), int(self.hi[1]) + 1)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return int(self.hi[0] - self.lo[0] + 1), int(self.hi[1] - self.lo[1] + 1)
+
+    def cells(self) -> NDArray[np.intp]:
+        """The window's cells (N, 2) row, col, in the order of ``dist``."""
+        rr, cc = np.mgrid[self.lo[0]:self.hi[0] + 1, self.lo[1]:self.hi[1] + 1]
+        return np.stack([rr.ravel(), cc.ravel()], axis=1)
+
+
+def _around(cm: Costmap, fp: NDArray[np.float64], cfg: PlannerConfig, cols: HeightColumns | None,
+            z_range: tuple[float, float] | None, may: NDArray[np.bool_] | None) -> _Around:
+    spec = cm.spec
+    # Only cells in the footprint's box grown by the reach can be within reach: measure those.
+    lo = np.clip(spec.to_cell(fp.min(axis=0) - cfg.reach), 0, [spec.rows - 1, spec.cols - 1])
+    hi = np.clip(spec.to_cell(fp.max(axis=0) + cfg.reach), 0, [spec.rows - 1, spec.cols - 1])
+    rr, cc = np.mgrid[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1]
+    rc = np.stack([rr.ravel(), cc.ravel()], axis=1)
+    centres = spec.to_world(rc)
+    dist = _distances(centres, fp)
+    win = (slice(lo[0], hi[0] + 1), slice(lo[1], hi[1] + 1))
+    seen = cm.occ.cells[win].ravel() == FREE
+    if may is not None:
+        seen &= may[win].ravel()
+    person = cfg.prefer_line_of_sight
+    region = -1
+    in_room = np.ones(len(rc), dtype=bool)
+    # The room matters only when a cell can be within reach (weights are only ever raised).
+    if person and (seen & np.isfinite(cm.weights[win].ravel()) & (dist <= cfg.reach)).any():
+        labels = room_labels(cm)
+        from capnav.language.rooms import object_region
+
+        region = object_region(labels, spec, fp.min(axis=0), fp.max(axis=0))
+        if region >= 0:
+            in_room = _inside_region(labels[win], region,
+                                     cfg.robot_radius / spec.resolution).ravel()
+    sight = SightTest(cm.occ, fp, polygon_centroid(fp), lo, hi, cols, z_range, cfg.eye_height) if person else None
+    return _Around(lo, hi, dist, seen, in_room, region, sight)
+
+
+def _around_cached(cm: Costmap, fp: NDArray[np.float64], cfg: PlannerConfig, cols: HeightColumns | None,
+                   z_range: tuple[float, float] | None) -> _Around:
+    """``_around`` kept per costmap for the most recently asked objects: a fleet asks for the same
+    objects again and again, from wherever its robots stand."""
+    kept: dict[Any, _Around] = cm.cache.setdefault("goal_around", {})
+    key = (fp.shape, fp.tobytes(), cfg, None if z_range is None else (float(z_range[0]), float(z_range[1])))
+    hit = kept.pop(key, None)
+    if hit is None:
+        hit = _around(cm, fp, cfg, cols, z_range, None)
+        while len(kept) >= AROUND_CACHE:
+            kept.pop(next(iter(kept)), None)  # the least recently asked
+    kept[key] = hit
+    return hit
+
+
 def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], start_xy: Any,
                 config: PlannerConfig | None = None, costmap: Costmap | None = None, *,
                 z_range: tuple[float, float] | None = None, columns: HeightColumns | None = None,
@@ -115,34 +193,19 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
     if allowed is not None and np.shape(allowed) != cm.weights.shape:
         raise InputError(f"allowed goal cells must have the grid's shape {cm.weights.shape}, got {np.shape(allowed)}")
     may = np.ones(cm.weights.shape, dtype=bool) if allowed is None else np.asarray(allowed, dtype=bool)
-    # Only cells in the footprint's box grown by the reach can be within reach: measure those.
-    lo = np.clip(spec.to_cell(fp.min(axis=0) - cfg.reach), 0, [spec.rows - 1, spec.cols - 1])
-    hi = np.clip(spec.to_cell(fp.max(axis=0) + cfg.reach), 0, [spec.rows - 1, spec.cols - 1])
-    rr, cc = np.mgrid[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1]
-    rc = np.stack([rr.ravel(), cc.ravel()], axis=1)
-    centres = spec.to_world(rc)
-    dist = _distances(centres, fp)
-    win = (slice(lo[0], hi[0] + 1), slice(lo[1], hi[1] + 1))
-    free = (cm.occ.cells[win].ravel() == FREE) & np.isfinite(cm.weights[win].ravel()) & may[win].ravel()
+    if allowed is None and cols is cm.columns:
+        ar = _around_cached(cm, fp, cfg, cols, z_range)
+    else:
+        ar = _around(cm, fp, cfg, cols, z_range, may)
+    lo, hi, dist, win = ar.lo, ar.hi, ar.dist, ar.win
+    free = ar.seen & np.isfinite(cm.weights[win].ravel())
     within = free & (dist <= cfg.reach)
     near = within & (dist <= cfg.reach - cfg.goal_margin)
     person = cfg.prefer_line_of_sight
-    region = -1
-    in_room = np.ones(len(rc), dtype=bool)
-    if person and within.any():
-        labels = room_labels(cm)
-        from capnav.language.rooms import object_region
-
-        region = object_region(labels, spec, fp.min(axis=0), fp.max(axis=0))
-        if region >= 0:
-            in_room = _inside_region(labels[win], region,
-                                     cfg.robot_radius / spec.resolution).ravel()
-    centroid = polygon_centroid(fp)
-    sight = SightTest(cm.occ, fp, centroid, lo, hi, cols, z_range, cfg.eye_height) if person else None
+    region, in_room, sight = ar.region, ar.in_room, ar.sight
     room_flag = None if region < 0 or not person else True
 
-    target = np.zeros(cm.weights.shape, dtype=bool)
-    target[win] = (near & in_room).reshape(rr.shape)
+    target = (near & in_room).reshape(ar.shape)
     if "min_weight" not in cm.cache:
         finite = cm.weights[np.isfinite(cm.weights)]
         cm.cache["min_weight"] = float(finite.min()) if finite.size else 1.0
@@ -155,10 +218,13 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
             why = f"the nearest reachable free cell {dist[i]:.2f} m from the object"
             if person:
                 why += (", in the object's room" if region >= 0 else "") + ", in sight of it on the map"
-            return _pose(rc[i], centres[i], fp, True, why, float(dist[i]), g * spec.resolution,
+            at = np.array(cell, dtype=np.intp)
+            return _pose(at, spec.to_world(at), fp, True, why, float(dist[i]), g * spec.resolution,
                          None if sight is None else True, room_flag)
     # Nothing passes the whole rule: the costs of every reachable cell, then relax one condition at a time.
     field = search.finish()
+    rc = ar.cells()
+    centres = spec.to_world(rc)
     cost = field[win].ravel() * spec.resolution
     reach_ok = np.isfinite(cost)
     within &= reach_ok

@@ -35,20 +35,18 @@ from capnav.planning.search import (
 
 
 @njit(cache=True, nogil=True)
-def _box_h(r: int, c: int, box: NDArray[np.int64]) -> float:
-    dr = max(box[0] - r, 0, r - box[2])
-    dc = max(box[1] - c, 0, c - box[3])
-    lo = min(dr, dc)
-    return (SQRT2 - 1.0) * lo + max(dr, dc)
-
-
-@njit(cache=True, nogil=True)
 def _resume(w: NDArray[np.floating], g: NDArray[np.float64], state: NDArray[np.uint8], hf: NDArray[np.float64],
             hi: NDArray[np.int64], size: int, target: NDArray[np.bool_], box: NDArray[np.int64], hscale: float
             ) -> tuple[int, int, NDArray[np.float64], NDArray[np.int64]]:
-    """Run until a target cell is settled (returned after expanding it) or the heap is empty (-1)."""
+    """Run until a target cell is settled (returned after expanding it) or the heap is empty (-1).
+    ``target`` covers ``box`` only (its rows, cols): the cells outside it are never targets."""
     rows, cols = w.shape
     flat = w.ravel()
+    r0, c0, r1, c1 = box[0], box[1], box[2], box[3]
+    bw = c1 - c0 + 1
+    off = np.empty(8, np.int64)
+    for k in range(8):
+        off[k] = _DR[k] * cols + _DC[k]
     while size > 0:
         u = _pop(hf, hi, size)
         size -= 1
@@ -57,17 +55,20 @@ def _resume(w: NDArray[np.floating], g: NDArray[np.float64], state: NDArray[np.u
         state[u] = CLOSED
         ur = u // cols
         uc = u - ur * cols
+        edge = ur == 0 or uc == 0 or ur == rows - 1 or uc == cols - 1  # only then can a neighbour be off the grid
         wu = flat[u]
         gu = g[u]
         for k in range(8):
             vr = ur + _DR[k]
             vc = uc + _DC[k]
-            if vr < 0 or vr >= rows or vc < 0 or vc >= cols:
+            if edge and (vr < 0 or vr >= rows or vc < 0 or vc >= cols):
                 continue
-            v = vr * cols + vc
-            sv = state[v]
+            v = u + off[k]
             wv = flat[v]
-            if sv == CLOSED or not wv < np.inf:
+            if not wv < np.inf:
+                continue
+            sv = state[v]
+            if sv == CLOSED:
                 continue
             ng = gu + _STEP[k] * 0.5 * (wu + wv)
             if ng < (g[v] if sv == OPEN else np.inf):
@@ -75,17 +76,21 @@ def _resume(w: NDArray[np.floating], g: NDArray[np.float64], state: NDArray[np.u
                 state[v] = OPEN
                 if size == hf.shape[0]:
                     hf, hi = _grow(hf, hi)
-                _push(hf, hi, size, ng + hscale * _box_h(vr, vc, box), v)
+                # The octile distance to the box, inline.
+                dr = max(r0 - vr, 0, vr - r1)
+                dc = max(c0 - vc, 0, vc - c1)
+                _push(hf, hi, size, ng + hscale * ((SQRT2 - 1.0) * min(dr, dc) + max(dr, dc)), v)
                 size += 1
-        if target[u]:
+        if r0 <= ur <= r1 and c0 <= uc <= c1 and target[(ur - r0) * bw + uc - c0]:
             return u, size, hf, hi
     return -1, size, hf, hi
 
 
 class NearestSearch:
-    """Settle the cells of ``target`` (bool, the grid's shape, inside ``box`` = (r0, c0, r1, c1))
-    in increasing path cost from ``start`` on ``weights``; ``next()`` gives the next one.
-    ``min_weight`` (the smallest finite weight) saves a scan of the grid when the caller knows it."""
+    """Settle the cells of ``target`` (bool, the grid's shape or the shape of ``box`` = (r0, c0, r1,
+    c1) inclusive, all of its cells inside the box) in increasing path cost from ``start`` on
+    ``weights``; ``next()`` gives the next one. ``min_weight`` (the smallest finite weight) saves a
+    scan of the grid when the caller knows it."""
 
     def __init__(self, weights: NDArray[np.floating], start: tuple[int, int], target: NDArray[np.bool_],
                  box: tuple[int, int, int, int], min_weight: float | None = None) -> None:
@@ -95,8 +100,15 @@ class NearestSearch:
         self.cols = cols
         self.g = np.empty(n, np.float64)
         self.state = np.zeros(n, np.uint8)
-        self.target = np.ascontiguousarray(target, dtype=np.bool_).ravel()
         self.box = np.asarray(box, dtype=np.int64)
+        r0, c0, r1, c1 = (int(v) for v in self.box)
+        t = np.asarray(target, dtype=np.bool_)
+        if t.shape == self.w.shape:  # the whole grid: what lies outside the box is no target
+            t = t[r0:r1 + 1, c0:c1 + 1]
+        if t.shape != (r1 - r0 + 1, c1 - c0 + 1):
+            raise ValueError(f"target must have the grid's shape {self.w.shape} or the box's "
+                             f"{(r1 - r0 + 1, c1 - c0 + 1)}, got {t.shape}")
+        self.target = np.ascontiguousarray(t).ravel()
         # Ties of f broken towards deeper cells (as A* in search.py): far fewer expansions on open floor.
         self.hscale = (_min_finite(self.w.ravel()) if min_weight is None else min_weight) * (1.0 + TIE_BREAK)
         s = int(start[0]) * cols + int(start[1])
@@ -121,7 +133,7 @@ class NearestSearch:
 
     def finish(self) -> NDArray[np.float64]:
         """Search on to the end; the cost (rows, cols) of every settled cell, inf elsewhere."""
-        none = np.zeros_like(self.target)
+        none = np.zeros_like(self.target)  # no target: on to the end
         if not self.exhausted:
             _resume(self.w, self.g, self.state, self.hf, self.hi, self.size, none, self.box, self.hscale)
             self.exhausted = True
