@@ -68,3 +68,14 @@ def test_a_landmark_relative_superlative_walks_too(scene) -> None:
 def test_an_unknown_distance_kind_is_refused() -> None:
     with pytest.raises(InputError, match="walking' or 'straight"):
         RetrievalConfig(distance="euclid")
+
+
+def test_no_cache_walks_again_and_a_negative_size_is_refused(scene) -> None:
+    cmap, _ = scene
+    los = np.array([o.extent_min[:2] for o in cmap.objects])
+    his = np.array([o.extent_max[:2] for o in cmap.objects])
+    uncached = FloorDistances(cmap.occupancy, los, his, cache_size=0)
+    a, b = uncached.from_point(ROBOT), uncached.from_point(ROBOT)
+    assert a is not b and np.array_equal(a, b)
+    with pytest.raises(InputError, match="cache_size must be >= 0"):
+        FloorDistances(cmap.occupancy, los, his, cache_size=-1)

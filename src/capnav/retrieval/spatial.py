@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from capnav.core.errors import InputError
 from capnav.core.geodesic import walk_base, walk_box_minima
 from capnav.core.grid import OCCUPIED, OccupancyGrid
 from capnav.language.rooms import box_cells, box_seeds, fill_gaps
@@ -102,6 +103,8 @@ class FloorDistances:
                                dtype=np.int64).reshape(-1, 4)
         self._grown = np.array([box_cells(self.spec, lo - RING, hi + RING)
                                 for lo, hi in zip(self.los, self.his, strict=True)], dtype=np.int64).reshape(-1, 4)
+        if cache_size < 0:
+            raise InputError(f"FloorDistances cache_size must be >= 0 (0: no cache), got {cache_size}")
         self._cache: dict[tuple[int, ...], NDArray[np.float64]] = {}
         self._size = cache_size
 
@@ -115,9 +118,10 @@ class FloorDistances:
             else:
                 hit = walk_box_minima(self._base, self.spec.cols, seeds, self._boxes, self._grown,
                                       self.spec.resolution, RING)
-            if len(self._cache) >= self._size:
+            while self._cache and len(self._cache) >= self._size:
                 self._cache.pop(next(iter(self._cache)))  # the least recently used source
-        self._cache[key] = hit
+        if self._size > 0:
+            self._cache[key] = hit
         return hit
 
     def from_point(self, xy: tuple[float, float]) -> NDArray[np.float64]:
