@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from capnav.core.errors import FrameError, InputError
 from capnav.core.frame import Frame
 from capnav.core.progress import track
+from capnav.mapping.box_carving import CarveConfig, DepthViews
 from capnav.mapping.cmap import CameraTrajectory, CapNavMap
 from capnav.mapping.frame_merge import FrameMergeConfig, merge_frame_detections
 from capnav.mapping.lifting import LiftConfig, LiftedDetection, lift_detection
@@ -53,6 +54,7 @@ class MapperConfig:
     occupancy: OccupancyConfig = field(default_factory=OccupancyConfig)
     lift: LiftConfig = field(default_factory=LiftConfig)
     frame_merge: FrameMergeConfig = field(default_factory=FrameMergeConfig)
+    carve: CarveConfig = field(default_factory=CarveConfig)
     on_bad_frame: Literal["skip", "raise"] = "skip"
     max_invalid_depth: float = 0.98
     max_pose_jump: float = 1.5  # m between consecutive frames; a shorter move is never reported as a jump
@@ -84,6 +86,9 @@ class Mapper:
                                encoder.text_space)
         self.tracker = SG3DTracker(self.config.tracker)
         self.memory = ObjectMemory(self.config.memory)
+        self.views = DepthViews(self.config.carve)  # small depth of the observed frames, for box_carving
+        self.carved_points = 0
+        self._views_cap = 64
         self.frames_used: list[int] = []
         self.skipped: list[dict[str, Any]] = []
         self.detector_errors: dict[str, dict[str, Any]] = {}
@@ -160,6 +165,11 @@ class Mapper:
                     continue
                 lifted.append(ld)
             self._track(frame, lifted)
+            if lifted and self.config.carve.enabled:
+                self.views.add(frame.index, frame.depth, frame.K, frame.T_wc)
+                if len(self.views.views) >= self._views_cap:  # forget the frames no observation keeps
+                    self.views.keep_only(self.memory.observed_frames())
+                    self._views_cap = max(64, 2 * len(self.views.views))
         self.frames_used.append(frame.index)
         self.seconds += time.perf_counter() - t0
         return True
@@ -188,6 +198,9 @@ class Mapper:
 
     def finish(self, meta: dict[str, Any] | None = None) -> CapNavMap:
         """Merge duplicates, export objects, derive occupancy; ``meta`` adds/overrides metadata."""
+        if self.config.carve.enabled:
+            self.views.keep_only(self.memory.observed_frames())
+            self.carved_points = self.memory.carve(self.views)
         merged = self.memory.merge_duplicates()
         objects = self.memory.export()
         occ = occupancy_from_voxels(self.voxels, self.config.occupancy)
@@ -204,6 +217,7 @@ class Mapper:
             "detections_without_depth": self.lift_skips,
             "tracks": self.tracker._next_id - 1,
             "merged_duplicates": merged,
+            "carved_points": self.carved_points,
             "merged_in_frame": self.frame_merges,
             "relinked_detections": self.memory.relinks,
             "detector": self.detector.id,

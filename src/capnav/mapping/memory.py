@@ -18,6 +18,7 @@ from scipy.spatial import ConvexHull, QhullError, cKDTree
 
 from capnav.core.categories import BY_NAME, confusable
 from capnav.core.errors import InputError
+from capnav.mapping.box_carving import DepthViews, carve
 from capnav.mapping.lifting import LiftedDetection
 from capnav.mapping.objects import MapObject, Observation
 from capnav.mapping.support import stands_on
@@ -225,6 +226,23 @@ class ObjectMemory:
         obj.points, obj.colors = allp[first], allc[first]
 
     # ---- end of mapping -----------------------------------------------------------------
+    def observed_frames(self) -> set[int]:
+        """The frames the kept and the buffered observations refer to."""
+        out = {o.frame_index for obj in self.objects.values() for o in obj.observations}
+        out |= {f for buf in self._pending.values() for _, _, f in buf}
+        return out
+
+    def carve(self, views: DepthViews) -> int:
+        """Drop each object's points that its own boxes, in the views that see them, contradict
+        (``box_carving``); returns how many points went."""
+        gone = 0
+        for obj in self.objects.values():
+            keep = carve(obj.points, [(o.frame_index, o.box) for o in obj.observations], views)
+            if not keep.all():
+                gone += int((~keep).sum())
+                obj.points, obj.colors = obj.points[keep], obj.colors[keep]
+        return gone
+
     def merge_duplicates(self) -> int:
         """Merge objects that overlap in 3D with compatible labels, best pair first; returns how
         many were merged. Only pairs whose boxes (grown by ``overlap_radius``) intersect are scored,
