@@ -169,6 +169,16 @@ def test_depth_in_the_wrong_scale_warns(tmp_path: Path, frames: list[Frame]) -> 
     assert "warning: the cameras are 0.25 m above the floor found" in res.output and "--depth-scale" in res.output
 
 
+def test_depth_read_too_far_names_the_depth_scale(tmp_path: Path, frames: list[Frame]) -> None:
+    """Millimetre PNGs read at 200 units per metre: every depth 5x too far, the cameras over 5 m above
+    any floor; the refusal names the depth scale, not only --up."""
+    src = export("open3d", frames, tmp_path / "rec")
+    res = CliRunner().invoke(app, ["import", "open3d", str(src), "-o", str(tmp_path / "ds"), "--depth-scale", "200",
+                                   "--no-progress"])
+    assert res.exit_code != 0
+    assert "is the depth scale right (--depth-scale" in res.output + str(res.exception), res.output
+
+
 @pytest.fixture(scope="module")
 def walk() -> list[Frame]:
     """Eight neighbouring views: a camera 1.25 m up, pitched 20 deg, stepping 8 cm and turning 3 deg a frame."""

@@ -413,7 +413,9 @@ def cue_words(cue: str, f: dict[str, float]) -> str:
         "support": f"only {100 * f['floor_share']:.1f}% of the depth points lie on that floor",
         "below": f"{100 * f['below_share']:.0f}% of the depth points lie below that floor",
         "cameras": f"only {100 * f['cameras_carried']:.0f}% of the cameras are 0.05-3 m above it "
-                   f"(median {f['camera_height_median_m']:+.2f} m)",
+                   f"(median {f['camera_height_median_m']:+.2f} m)" + (
+                       "; cameras that far above every floor mean depth read too far: is the depth scale right "
+                       "(--depth-scale: units per metre)?" if f["camera_height_median_m"] > 3.0 else ""),
         "upright": (f"the image rows would be {f['roll_deg']:.0f} deg from level" if f["roll_deg"] > 20 else
                     f"the image-down axis is {f['upright_deg']:.0f} deg from that gravity, so the image rows "
                     "would not tell which way is down"),
