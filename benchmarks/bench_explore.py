@@ -19,12 +19,12 @@ import time
 from dataclasses import replace
 from typing import Any
 
-from capnav.eval.baselines.explore import explorer as explorer_module
-from capnav.eval.baselines.explore.explorer import ExplorerConfig
 from capnav.eval.baselines.explore.lmnav import LMNavConfig
 from capnav.eval.baselines.explore.object_search import ObjectSearchConfig
 from capnav.eval.baselines.explore.zson import ZSONConfig
 from capnav.eval.scene_task import EvalConfig, SceneTask, run_scene
+from capnav.explore import explorer as explorer_module
+from capnav.explore.explorer import ExplorerConfig
 
 METHODS = ("cow", "zson", "lmnav")
 

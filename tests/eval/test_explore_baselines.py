@@ -15,16 +15,16 @@ import pytest
 from capnav.core.categories import CONFUSION_GROUPS, NAMES
 from capnav.core.errors import InputError
 from capnav.core.grid import FREE, OCCUPIED, UNKNOWN, GridSpec, OccupancyGrid
-from capnav.eval.baselines.explore.explorer import ExplorerConfig
-from capnav.eval.baselines.explore.frontier import find_frontiers
 from capnav.eval.baselines.explore.goal_match import GoalMatcher
 from capnav.eval.baselines.explore.lmnav import LMNavMethod
 from capnav.eval.baselines.explore.object_search import ObjectSearchConfig
-from capnav.eval.baselines.explore.online_map import OnlineMap
-from capnav.eval.baselines.explore.sighting import Sighting
 from capnav.eval.baselines.explore.topo_graph import GraphConfig, build_graph
 from capnav.eval.baselines.explore.zson import ZSONConfig, ZSONMethod
 from capnav.eval.method import METHODS, SceneContext, SubgoalOutcome, create_method, load_methods
+from capnav.explore.explorer import ExplorerConfig
+from capnav.explore.frontier import find_frontiers
+from capnav.explore.online_map import OnlineMap
+from capnav.explore.sighting import Sighting
 from capnav.language import create_embedder
 from capnav.perception import create_detector
 from capnav.planning import PlannerConfig, build_costmap
@@ -119,7 +119,7 @@ def test_online_map_matches_the_true_layout(sim: Simulator) -> None:
 
 
 def test_the_explorer_looks_at_keyframes_and_before_decisions(sim: Simulator) -> None:
-    from capnav.eval.baselines.explore.explorer import FrontierExplorer
+    from capnav.explore.explorer import FrontierExplorer
 
     agent = sim.spawn_agent(*sim.random_navigable_point(np.random.default_rng(3)))
     ex = FrontierExplorer(agent, None, ExplorerConfig())
@@ -189,7 +189,7 @@ def test_goal_matcher_categories_and_free_form(embedder) -> None:  # type: ignor
 
 def test_zson_prefers_the_frontier_near_a_related_object(embedder) -> None:  # type: ignore[no-untyped-def]
     """Two frontiers at the same distance: the one next to a sink wins for 'toilet'."""
-    from capnav.eval.baselines.explore.frontier import Frontier
+    from capnav.explore.frontier import Frontier
 
     method = ZSONMethod()
     fa = Frontier((0, 0), (0.0, 0.0), (0.0, 0.0), 10, 3.0)

@@ -14,11 +14,11 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from capnav.eval.baselines.explore.explorer import FrontierExplorer
-from capnav.eval.baselines.explore.frontier import Frontier
 from capnav.eval.baselines.explore.goal_match import GoalMatcher
 from capnav.eval.baselines.explore.object_search import ObjectSearch, ObjectSearchConfig, with_planner
 from capnav.eval.method import METHODS, NavMethod
+from capnav.explore.explorer import FrontierExplorer
+from capnav.explore.frontier import Frontier
 from capnav.planning import PlannerConfig
 
 

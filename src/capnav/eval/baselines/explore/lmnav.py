@@ -19,10 +19,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from capnav.core.errors import InputError
-from capnav.eval.baselines.explore.explorer import ExplorerConfig, FrontierExplorer, Status
 from capnav.eval.baselines.explore.goal_match import GoalMatcher
 from capnav.eval.baselines.explore.topo_graph import GraphConfig, TopoGraph, build_graph, frames_of
 from capnav.eval.method import METHODS, Agent, NavMethod, SceneContext, SubgoalOutcome
+from capnav.explore.explorer import ExplorerConfig, FrontierExplorer, Status
 from capnav.planning import PlannerConfig
 
 

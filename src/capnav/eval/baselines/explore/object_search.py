@@ -22,11 +22,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.core.errors import InputError
-from capnav.eval.baselines.explore.explorer import ExplorerConfig, FrontierExplorer, Status
-from capnav.eval.baselines.explore.frontier import Frontier
 from capnav.eval.baselines.explore.goal_match import GoalMatcher
-from capnav.eval.baselines.explore.sighting import Sighting
 from capnav.eval.method import Agent, SceneContext, SubgoalOutcome
+from capnav.explore.explorer import ExplorerConfig, FrontierExplorer, Status
+from capnav.explore.frontier import Frontier
+from capnav.explore.sighting import Sighting
 from capnav.planning import PlannerConfig
 
 

@@ -22,8 +22,8 @@ from scipy.sparse import csgraph
 from capnav.core.errors import InputError
 from capnav.core.frame import Frame
 from capnav.core.grid import FREE
-from capnav.eval.baselines.explore.online_map import OnlineMap, OnlineMapConfig
-from capnav.eval.baselines.explore.sighting import Sighting, lift
+from capnav.explore.online_map import OnlineMap, OnlineMapConfig
+from capnav.explore.sighting import Sighting, lift
 
 
 @dataclass(frozen=True)

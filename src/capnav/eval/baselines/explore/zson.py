@@ -16,11 +16,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.core.errors import InputError
-from capnav.eval.baselines.explore.explorer import FrontierExplorer
-from capnav.eval.baselines.explore.frontier import Frontier
 from capnav.eval.baselines.explore.goal_match import GoalMatcher
 from capnav.eval.baselines.explore.object_search import ObjectSearch, ObjectSearchConfig, with_planner
 from capnav.eval.method import METHODS, NavMethod
+from capnav.explore.explorer import FrontierExplorer
+from capnav.explore.frontier import Frontier
 from capnav.planning import PlannerConfig
 
 

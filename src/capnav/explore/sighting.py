@@ -1,4 +1,4 @@
-"""A detection lifted to the floor plane: what the exploration baselines remember of a sighting.
+"""A detection lifted to the floor plane: what an exploring robot remembers of a sighting.
 
 No object map is built: a sighting is one detection's label, score and robust 3D centre (the
 median of its mask's back-projected depth, eq. 2-3) together with where it was seen from.

@@ -24,9 +24,9 @@ from numpy.typing import NDArray
 from capnav.core.errors import CapNavError, InputError
 from capnav.core.frame import Frame
 from capnav.core.grid import FREE, UNKNOWN, GridSpec, OccupancyGrid
-from capnav.eval.baselines.explore.frontier import Frontier, find_frontiers
-from capnav.eval.baselines.explore.online_map import OnlineMap, OnlineMapConfig
-from capnav.eval.baselines.explore.sighting import Sighting, lift
+from capnav.explore.frontier import Frontier, find_frontiers
+from capnav.explore.online_map import OnlineMap, OnlineMapConfig
+from capnav.explore.sighting import Sighting, lift
 from capnav.planning import Costmap, PlannerConfig, build_costmap, plan_path, select_goal
 from capnav.planning.search import cost_field
 
