@@ -35,3 +35,23 @@ def test_episodes_per_change_class() -> None:
     res = {"summaries": [{"method": "capnav", "protocol": "description/moved", "independent": 0.5, "subgoals": 4}],
            "cpu_seconds": {"update_cpu_s": 1.0, "remap_visit2_cpu_s": 2.0}}
     assert "| capnav | 50.0 (4) |" in table(res)
+
+
+def test_search_counts_only_within_three_walks() -> None:
+    from capnav.eval.change_track import _within_budget
+    from capnav.eval.metrics import SubgoalRecord
+
+    def rec(path: float) -> SubgoalRecord:
+        return SubgoalRecord(method="capnav-search", protocol="description/added", scene_seed=0, episode_id="e",
+                             index=0, text="the chair", category="chair", target_ids=[1], kind="category",
+                             success=True, distance_to_goal=0.5, path_length=path, shortest_path=4.0,
+                             start_xy=(0.0, 0.0), stop_xy=(1.0, 1.0), found=True, retrieval_correct=None,
+                             query_time_s=0.0, steps=1, reason="found: ...", success_strict=True)
+
+    short, long = rec(11.9), rec(12.1)
+    _within_budget(short)
+    _within_budget(long)
+    assert short.success and short.success_strict
+    assert not long.success and long.success_strict is False and long.reason.startswith("reached, but drove 12.1 m")
+    res = {"summaries": [], "search": {"subgoals": 2, "budget": "3x", "within_budget": 1, "reached_any_length": 2}}
+    assert "within 3x 1 of 2, reached at any length 2" in table(res)

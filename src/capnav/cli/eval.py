@@ -55,7 +55,8 @@ def register(app: typer.Typer) -> None:
         changes: Annotated[str | None, typer.Option(
             "--changes", metavar="moved=N,removed=N,added=N",
             help="the change track instead (docs/change.md): map visit 1, update with visit 2 after these "
-                 "changes, score per change class for capnav (updated map), capnav-static, capnav-remap")] = None,
+                 "changes, score per change class for capnav (updated map), capnav-static, capnav-remap and "
+                 "capnav-search (visit 1's map and --search, on moved and added objects)")] = None,
         per_class: Annotated[int, typer.Option(min=1, help="with --changes: subgoals per change class and "
                                                            "apartment")] = 8,
     ) -> None:

@@ -1,5 +1,7 @@
 """``capnav navigate MAP "instruction"``: retrieve, choose a goal pose, plan with A*; drive in the
 simulator when the map comes from ``capnav sim``, else write the goal and path for a robot stack.
+With ``--search`` (simulator maps) the robot confirms the goal with its own camera and searches
+for it when the map is silent or stale (``capnav.explore.search``).
 A request of several goals ("the fridge, then the sofa") is planned or driven leg by leg, each
 from where the one before ended; a leg that fails ends the sequence and the command fails."""
 
@@ -51,6 +53,17 @@ def register(app: typer.Typer) -> None:
         through_unknown: Annotated[bool, typer.Option(
             "--through-unknown", help="accept a planned path that crosses unknown space (default: such a plan is "
                                       "reported as not ok)")] = False,
+        search: Annotated[bool, typer.Option(
+            "--search", help="simulator maps: confirm the goal with the robot's camera and, when the map has no such "
+                             "object, it is not at its place or it is gone, search rooms and unseen space for it")
+                          ] = False,
+        budget_m: Annotated[float, typer.Option(help="--search: metres the robot may drive")] = 60.0,
+        budget_s: Annotated[float | None, typer.Option(help="--search: seconds the search may take")] = None,
+        visit: Annotated[int, typer.Option(help="drive in this visit of the simulated apartment (capnav sim --visit)")
+                         ] = 1,
+        changes: Annotated[str, typer.Option(help="the changes of --visit > 1, e.g. moved=3,removed=2,added=2")
+                           ] = "",
+        change_seed: Annotated[int, typer.Option(help="the seed of the changes of --visit > 1")] = 0,
     ) -> None:
         """Go to the object an instruction describes: a goal pose (x, y, yaw facing it) and an A* path in
         the map's frame (JSON, PNG, ROS map_server PGM + YAML), driven in the simulator for sim maps."""
@@ -80,6 +93,18 @@ def register(app: typer.Typer) -> None:
         if scene is not None and ep_scene is not None and scene != ep_scene:
             raise InputError(f"--scene {scene} is not the episode's apartment {ep_scene} ({episode})")
         scene_seed = next((s for s in (scene, ep_scene, cmap.meta.get("scene_seed")) if s is not None), None)
+        if search and (scene_seed is None or drive is False):
+            raise InputError(f"--search drives the simulated robot and looks with its camera, but {map_file} "
+                             + ("is a map of a recording with no simulator scene (no scene seed)" if scene_seed is None
+                                else "is to be planned only (--plan-only)")
+                             + ": drop --search to plan on the map alone, or give --scene SEED for a simulated "
+                               "apartment")
+        from capnav.sim.changes import ChangeSpec
+
+        spec = ChangeSpec.parse(changes) if changes else None
+        if visit < 1 or (visit == 1 and spec is not None):
+            raise InputError(f"--visit {visit} with --changes {changes!r}: changes apply to a later visit (--visit 2 "
+                             "or more); visit 1 is the apartment as generated")
         if drive and scene_seed is None:
             raise InputError(f"{map_file} records no scene seed to drive in (a map of a recording): pass --scene "
                              "SEED, or plan only (the default)")
@@ -92,6 +117,8 @@ def register(app: typer.Typer) -> None:
         from capnav.retrieval.query import parse_goals
 
         goals = parse_goals(instruction, retriever.embedder)
+        if search and len(goals) > 1:
+            raise InputError(f"--search takes one goal; {instruction!r} names {len(goals)} ({goals[0].text!r}, ...)")
         if drive is False or scene_seed is None:
             if len(goals) == 1:
                 _plan_only(con, cmap, retriever, instruction, given, out, map_file, through_unknown)
@@ -104,7 +131,7 @@ def register(app: typer.Typer) -> None:
 
         legs = []
         stopped = ""
-        with Simulator.from_seed(int(scene_seed)) as sim:
+        with Simulator.from_seed(int(scene_seed), visit=visit, changes=spec, change_seed=change_seed) as sim:
             if given is None and cmap.trajectory is not None and len(cmap.trajectory):
                 from capnav.planning.on_map import camera_start
 
@@ -112,6 +139,11 @@ def register(app: typer.Typer) -> None:
                 con.print(f"start: {where}", highlight=False)
             pose = given or random_start(sim, seed)
             agent = sim.spawn_agent(*pose)
+            if search:
+                ok = _search(con, cmap, retriever, instruction, agent, out, budget_m, budget_s)
+                if not ok:
+                    raise typer.Exit(1)
+                return
             for k, goal in enumerate(goals):
                 if len(goals) > 1:
                     con.print(f"[bold]goal {k + 1} of {len(goals)}[/]: {goal.text}", highlight=False)
@@ -140,6 +172,36 @@ def register(app: typer.Typer) -> None:
             con.print(f"[red]stopped[/]: {stopped}", highlight=False)
         if not (all(r.reached for r in legs) and len(legs) == len(goals)):
             raise typer.Exit(1)
+
+
+def _search(con: Console, cmap: CapNavMap, retriever: Retriever, instruction: str, agent: object, out: Path,
+            budget_m: float, budget_s: float | None) -> bool:
+    """``--search``: ask the map, go and look, search if needed; each step's reason on the console
+    and in navigate.json (``search.steps``); ``goal`` is the pose the robot stopped at when found."""
+    import numpy as np
+
+    from capnav.explore.search import SearchConfig, search_goal
+    from capnav.io.rosmap import write_ros_map
+    from capnav.perception import create_detector
+    from capnav.viz.topdown import write_navigation
+
+    x, y, yaw = (float(v) for v in agent.pose)  # type: ignore[attr-defined]
+    q, res = search_goal(cmap, retriever, instruction, agent, create_detector("sim"),
+                         SearchConfig(budget_m=budget_m, budget_s=budget_s))
+    for k, step in enumerate(res.steps):
+        colour = {"found": "green", "not found": "red"}.get(step.action, "default")
+        con.print(f"[{colour}]{k + 1}. {step.action}[/] (driven {step.driven_m:.1f} m): {step.reason}",
+                  highlight=False)
+    end = tuple(float(v) for v in agent.pose)  # type: ignore[attr-defined]
+    traj = np.asarray(getattr(agent, "trajectory", [(x, y, yaw)]), dtype=np.float64)[:, :2]
+    title = f'"{instruction}" --search: {"found" if res.found else "NOT found"}, drove {res.driven_m:.1f} m'
+    png, js = write_navigation(out, "navigate", cmap.occupancy, cmap.objects, res.chosen_object, None, traj,
+                               (x, y, yaw), end, title, goal=end if res.found else None,  # type: ignore[arg-type]
+                               instruction=instruction, ok=res.found, reason=res.reason, retrieval=q.to_dict(),
+                               search=res.to_dict())
+    pgm, yml = write_ros_map(cmap.occupancy, out / "navigate_map.yaml")
+    con.print(f"{png}\n{js}\n{yml} (+ {pgm.name})", highlight=False)
+    return res.found
 
 
 def _stopped(k: int, n: int, text: str, what: str) -> str:

@@ -5,7 +5,11 @@ then three maps answer the same one-subgoal episodes in the visit-2 world:
 
 * ``capnav``: visit 1's map updated with visit 2 (``capnav map --update``, then captioned);
 * ``capnav-static``: visit 1's map as it was;
-* ``capnav-remap``: visit 2 mapped from scratch.
+* ``capnav-remap``: visit 2 mapped from scratch;
+* ``capnav-search``: visit 1's map with ``navigate --search``, on the objects the first map does not
+  hold where they are (``moved`` and ``added``): success = reached within 1 m with a driven length
+  of at most ``SEARCH_BUDGET`` times the walking distance from the start (the harness judges the
+  length; the search is not told it).
 
 Goals are written from the truth the user holds, per change class (protocol ``description/<class>``):
 ``moved`` (described as at visit 2; success = reached at its new place), ``removed`` (described as at
@@ -35,7 +39,11 @@ from capnav.eval.metrics import SubgoalRecord, summarize_all
 from capnav.sim.changes import ChangeSpec
 
 CLASSES = ("moved", "removed", "added", "unchanged")
-METHODS = ("capnav", "capnav-static", "capnav-remap")
+METHODS = ("capnav", "capnav-static", "capnav-remap", "capnav-search")
+#: The change classes ``capnav-search`` runs on: objects not in the first map where they are now.
+SEARCH_CLASSES = ("moved", "added")
+#: Driven length allowed to a search, in walking distances from the start to the object.
+SEARCH_BUDGET = 3.0
 
 
 @dataclass(frozen=True)
@@ -172,20 +180,36 @@ def run_change_scene(scene: int, cfg: ChangeTrackConfig, out: Path, progress: bo
         truth = SceneTruth.from_manifest(sim.manifest, nav.spec, nav.cells == FREE,
                                          sight=sight_grid(sim.apartment, nav.spec))
         episodes = _episodes(scene, cfg, man1, man2, truth)
-        for name, cmap, frames in (("capnav", mu, r2), ("capnav-static", m1, r1), ("capnav-remap", mr, r2)):
-            method = create_method("capnav")
+        for name, cmap, frames in (("capnav", mu, r2), ("capnav-static", m1, r1), ("capnav-remap", mr, r2),
+                                   ("capnav-search", m1, r1)):
+            method = create_method(name if name == "capnav-search" else "capnav")
             ctx = SceneContext(scene_seed=scene, seed=cfg.seed, sim=sim, embedder=emb, detector=detector(),
                                prior_map=cmap, occupancy=cmap.occupancy, frames=frames, workdir=folder / name)
             for cls, eps in episodes.items():
+                if name == "capnav-search" and cls not in SEARCH_CLASSES:
+                    continue
                 for ep in eps:
                     for r in run_episode(method, ctx, ep, truth, f"description/{cls}"):
                         r.method = name
+                        if name == "capnav-search":
+                            _within_budget(r)
                         records.append(r)
                         write_json(out / "logs" / name / cls / f"{ep.id}.json",
                                    {"episode": ep.model_dump(), "subgoal": r.to_dict()})
     return {"scene_seed": scene, "records": [r.to_dict() for r in records], "timings": timings,
             "update": rep.to_dict(), "objects": {"visit1": len(m1.objects), "updated": len(mu.objects),
                                                  "retired": len(mu.retired), "remapped": len(mr.objects)}}
+
+
+def _within_budget(r: SubgoalRecord) -> None:
+    """A search succeeds only when it reached the object within ``SEARCH_BUDGET`` walking distances."""
+    limit = SEARCH_BUDGET * r.shortest_path
+    if r.success and not r.path_length <= limit:
+        r.success = False
+        r.success_strict = False if r.success_strict is not None else None
+        r.success_room = False if r.success_room is not None else None
+        r.reason = f"reached, but drove {r.path_length:.1f} m, over {SEARCH_BUDGET:g}x the {r.shortest_path:.1f} m " \
+                   f"walk ({limit:.1f} m); {r.reason}"
 
 
 def run_change_track(cfg: ChangeTrackConfig, out: Path, progress: bool = True) -> dict[str, Any]:
@@ -196,8 +220,15 @@ def run_change_track(cfg: ChangeTrackConfig, out: Path, progress: bool = True) -
     recs = [SubgoalRecord.from_dict(r) for s in scenes for r in s["records"]]
     summaries = [s.to_dict() for s in summarize_all(recs)]
     cpu = {k: round(sum(s["timings"][k] for s in scenes), 3) for k in scenes[0]["timings"]} if scenes else {}
+    searched = [r for r in recs if r.method == "capnav-search"]
+    search = {"subgoals": len(searched), "budget": f"{SEARCH_BUDGET:g}x the walking distance from the start",
+              "within_budget": sum(r.success for r in searched),
+              "reached_any_length": sum(r.success or r.reason.startswith("reached, but drove") for r in searched),
+              "driven_over_walk": [round(r.path_length / r.shortest_path, 3) for r in searched
+                                   if r.success and r.shortest_path > 0]}
     results = {"track": "change", "changes": str(cfg.changes), "seed": cfg.seed, "scenes": cfg.scene_seeds(),
                "camera": [cfg.width, cfg.height], "detector": f"sim:{cfg.noise}", "summaries": summaries,
+               "search": search,
                "cpu_seconds": cpu, "per_scene": [{k: v for k, v in s.items() if k != "records"} for s in scenes]}
     write_json(out / "results.json", results)
     return results
@@ -213,6 +244,12 @@ def table(results: dict[str, Any]) -> str:
             s = by.get((m, c))
             cells.append("-" if s is None else f"{100 * s['independent']:.1f} ({s['subgoals']})")
         lines.append(f"| {m} | " + " | ".join(cells) + " |")
+    srch = results.get("search") or {}
+    if srch.get("subgoals"):
+        lines.append("")
+        lines.append(f"capnav-search ({', '.join(SEARCH_CLASSES)}): reached within {srch['budget']} "
+                     f"{srch['within_budget']} of {srch['subgoals']}, reached at any length "
+                     f"{srch['reached_any_length']}")
     cpu = results.get("cpu_seconds", {})
     if cpu:
         lines.append("")

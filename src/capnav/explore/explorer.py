@@ -6,8 +6,9 @@ since the last look (a 60 degree turn or 0.5 m; the camera sees 90 degrees), aft
 and before every decision that reads the map. Consecutive 30 degree / 0.25 m views overlap by
 two thirds, and looking is most of the cost of an action, so this halves the work while the map
 and the sightings still grow as the agent moves, and a ``stop`` predicate ends the search at the
-first keyframe that shows the goal. The budget counts actions; running out is a timeout, running
-out of reachable frontiers means the whole reachable space was seen.
+first keyframe that shows the goal. The budget counts actions (and, when ``path_limit`` is set,
+metres driven: the action budget ends when the agent has driven that far); running out is a
+timeout, running out of reachable frontiers means the whole reachable space was seen.
 """
 
 from __future__ import annotations
@@ -61,6 +62,7 @@ class ExplorerConfig:
     goal_snap: float = 0.5  # m, a goal inside the inflated obstacles moves to the nearest free cell
     keyframe_turn_deg: float = 60.0  # look again after turning this much since the last look ...
     keyframe_move: float = 0.5  # ... or moving this far (m); 0 and 0: look after every action
+    sighting_colours: bool = False  # name each sighting's dominant colours (a search for "the blue chair")
 
     def __post_init__(self) -> None:
         if self.max_steps is not None and self.max_steps < 1:
@@ -90,6 +92,7 @@ class FrontierExplorer:
         self.steps = 0
         self.frame: Frame | None = None
         self.looks = 0  # observations made (the costly part of an action)
+        self.path_limit: float | None = None  # metres of agent odometry after which the budget is spent
         self._looked_from: tuple[float, float, float] | None = None  # pose of the last observation
         agent_cfg = getattr(agent, "cfg", None) or getattr(agent, "config", None)
         self.turn = math.radians(float(getattr(agent_cfg, "turn_deg", 30.0)))
@@ -116,7 +119,8 @@ class FrontierExplorer:
         self.map.update(frame)
         self.map.mark_free_disk((x, y))
         dets = self.detector.detect(frame) if self.detector is not None else []
-        self.new_sightings = lift(frame, dets, self.config.min_sighting_points)
+        self.new_sightings = lift(frame, dets, self.config.min_sighting_points,
+                                  colours=self.config.sighting_colours)
         self.sightings.extend(self.new_sightings)
         return self.new_sightings
 
@@ -135,6 +139,8 @@ class FrontierExplorer:
         self.steps += 1
         x, y, yaw = (float(v) for v in self.agent.pose)
         self.map.mark_free_disk((x, y))  # driven over, so free, whether or not this is a keyframe
+        if self.path_limit is not None and float(getattr(self.agent, "path_length", 0.0)) >= self.path_limit:
+            self.budget = 0
         if not ok:
             r = self.config.planner.robot_radius + 0.06
             self.map.mark_obstacle((x + r * math.cos(yaw), y + r * math.sin(yaw)))

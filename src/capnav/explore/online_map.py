@@ -6,6 +6,10 @@ and the 2D rays from the camera to floor and obstacle points clear the cells the
 is counted per frame, and a cell is an obstacle when its obstacle count, weighted, is at least its
 free count: a wall seen once stays a wall, while a speckle of depth noise in a cell seen free many
 times does not block a door.
+
+A map may start from a prior grid (``prior``: a saved map's occupancy): its cells stand wherever
+the agent's own depth has said nothing yet, and the agent's evidence replaces them cell by cell,
+so a chair that left its place is seen free again as soon as the robot looks there.
 """
 
 from __future__ import annotations
@@ -52,7 +56,8 @@ class OnlineMapConfig:
 class OnlineMap:
     """Occupancy evidence accumulated from posed depth frames, centred on where the agent started."""
 
-    def __init__(self, center_xy: tuple[float, float], config: OnlineMapConfig | None = None) -> None:
+    def __init__(self, center_xy: tuple[float, float], config: OnlineMapConfig | None = None,
+                 prior: OccupancyGrid | None = None) -> None:
         self.config = cfg = config or OnlineMapConfig()
         n = int(np.ceil(2 * cfg.half_extent / cfg.resolution))
         self.spec = GridSpec(float(center_xy[0]) - cfg.half_extent, float(center_xy[1]) - cfg.half_extent,
@@ -65,6 +70,7 @@ class OnlineMap:
         self._stamp_occ = np.zeros((n, n), np.int32)
         self.frames_seen = 0
         self._lattice_mask: NDArray[np.bool_] | None = None
+        self._prior = _resample(prior, self.spec) if prior is not None else None
 
     # ------------------------------------------------------------------ updates
     def update(self, frame: Frame) -> None:
@@ -106,6 +112,7 @@ class OnlineMap:
         out = OnlineMap.__new__(OnlineMap)
         out.config, out.spec, out.frames_seen = self.config, self.spec, self.frames_seen
         out._lattice_mask = self._lattice_mask
+        out._prior = self._prior
         for name in ("_free", "_occ", "_forced_free", "_forced_occ", "_stamp_free", "_stamp_occ"):
             setattr(out, name, getattr(self, name).copy())
         return out
@@ -114,8 +121,8 @@ class OnlineMap:
     def cells(self) -> NDArray[np.uint8]:
         """FREE / OCCUPIED / UNKNOWN per cell under the evidence rule of the module docstring."""
         occ = (self._occ > 0) & (self.config.obstacle_weight * self._occ >= self._free)
-        out = np.full(self._free.shape, UNKNOWN, np.uint8)
-        out[self._free > 0] = FREE
+        out = np.full(self._free.shape, UNKNOWN, np.uint8) if self._prior is None else self._prior.copy()
+        out[(self._free > 0) & ~occ] = FREE
         out[occ] = OCCUPIED
         out[self._forced_free] = FREE
         out[self._forced_occ] = OCCUPIED
@@ -125,7 +132,12 @@ class OnlineMap:
         return OccupancyGrid(self.spec, self.cells())
 
     def known_fraction(self) -> float:
+        """The share of cells the agent's own depth has spoken for (the prior not counted)."""
         return float(((self._free > 0) | (self._occ > 0)).mean())
+
+    def observed(self) -> NDArray[np.bool_]:
+        """Cells the agent's own depth has spoken for."""
+        return (self._free > 0) | (self._occ > 0)
 
     # ------------------------------------------------------------------ helpers
     def _lattice(self, height: int, width: int) -> NDArray[np.bool_]:
@@ -145,6 +157,17 @@ class OnlineMap:
         keep = (rr**2 + cc**2) * self.spec.resolution**2 <= radius**2 + 1e-12
         cells = np.stack([rr[keep] + rc[0], cc[keep] + rc[1]], axis=1)
         return cells[self.spec.inside(cells)]
+
+
+def _resample(grid: OccupancyGrid, spec: GridSpec) -> NDArray[np.uint8]:
+    """``grid``'s cells read at the centres of ``spec``'s cells (nearest cell; UNKNOWN outside it)."""
+    rr, cc = np.mgrid[0:spec.rows, 0:spec.cols]
+    xy = spec.to_world(np.stack([rr.ravel(), cc.ravel()], axis=1))
+    src = grid.spec.to_cell(xy)
+    inside = grid.spec.inside(src)
+    out = np.full(spec.rows * spec.cols, UNKNOWN, np.uint8)
+    out[inside] = grid.cells[src[inside, 0], src[inside, 1]]
+    return out.reshape(spec.rows, spec.cols)
 
 
 @njit(cache=True)

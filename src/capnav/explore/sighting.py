@@ -25,12 +25,15 @@ class Sighting:
     distance: float  # camera centre to that point (m)
     frame_index: int
     camera_xy: tuple[float, float]
+    #: CIELAB of the mask's dominant colours, largest share first (only when lifted with ``colours``).
+    colours: tuple[tuple[float, float, float], ...] = ()
 
 
 def lift(frame: Frame, detections: Sequence[Detection], min_points: int = 10,
-         max_distance: float = 6.0) -> list[Sighting]:
+         max_distance: float = 6.0, colours: bool = False) -> list[Sighting]:
     """Sightings of ``detections`` with enough valid depth in their masks; others are dropped
-    (a mask over invalid depth gives no place to go)."""
+    (a mask over invalid depth gives no place to go). ``colours``: also the mask pixels' dominant
+    colours (clusters with at least a fifth of the pixels), for a goal that names a colour."""
     out: list[Sighting] = []
     cam = np.asarray(frame.T_wc, dtype=np.float64)[:3, 3]
     for d in detections:
@@ -41,6 +44,11 @@ def lift(frame: Frame, detections: Sequence[Detection], min_points: int = 10,
         dist = float(np.linalg.norm(c - cam))
         if dist > max_distance:
             continue
+        labs: tuple[tuple[float, float, float], ...] = ()
+        if colours:
+            from capnav.language.colors import object_colors
+
+            labs = tuple(k.lab for k in object_colors(frame.rgb[d.mask].reshape(-1, 3)) if k.fraction >= 0.2)
         out.append(Sighting(d.label, float(d.score), (float(c[0]), float(c[1])), float(c[2]), dist,
-                            int(frame.index), (float(cam[0]), float(cam[1]))))
+                            int(frame.index), (float(cam[0]), float(cam[1])), labs))
     return out

@@ -1,0 +1,150 @@
+"""The search of ``navigate --search`` in two box rooms joined by a door: the first map saw only
+room A. An object in room B (a room the map never saw) is searched for and reached; a chair the
+map has in room A but that was carried into room B is not at its place, so the robot searches and
+finds it there (not the red chair that stayed); an object that is nowhere ends the search with
+"not found within budget"."""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "mapping"))
+from _synth_scene import ROOM, Box, HashEmbedder, render
+
+from capnav.core.frame import Frame
+from capnav.core.geometry import Intrinsics, look_at_pose
+from capnav.explore.search import Goal, ObjectSearch, SearchConfig
+from capnav.mapping import CapNavMap, build_map
+from capnav.perception import create_detector, create_encoder
+
+SOFA, CHAIR, TABLE, LAMP = 1, 3, 5, 15
+BLUE, RED = (30, 40, 200), (200, 30, 30)
+WALLS = [Box((0.6, -3.0, 0.0), (0.75, -0.5, 2.5), 0, 0, (225, 225, 215)),
+         Box((0.6, 0.5, 0.0), (0.75, 3.0, 2.5), 0, 0, (225, 225, 215))]
+K = Intrinsics.from_fov(160, 120, 70.0)
+
+
+def _room_a(blue_chair_xy: tuple[float, float]) -> list[Box]:
+    x, y = blue_chair_xy
+    return [*WALLS,
+            Box((-2.5, -2.5, 0.0), (-0.8, -1.7, 0.8), 1, SOFA, (200, 200, 210)),
+            Box((-2.4, 1.2, 0.0), (-1.4, 2.2, 0.75), 2, TABLE, (120, 80, 40)),
+            Box((x - 0.25, y - 0.25, 0.0), (x + 0.25, y + 0.25, 0.9), 3, CHAIR, BLUE),
+            Box((-2.5, -0.3, 0.0), (-2.0, 0.2, 0.9), 6, CHAIR, RED),
+            Box((2.2, -2.5, 0.0), (2.5, -2.2, 1.6), 5, LAMP, (240, 220, 90))]
+
+
+class BoxAgent:
+    """A disc robot in the box world: turns of 30 degrees, steps of 0.25 m, a camera at 1.2 m."""
+
+    class cfg:
+        turn_deg = 30.0
+        forward_step = 0.25
+
+    def __init__(self, boxes: list[Box], x: float, y: float, yaw: float = 0.0) -> None:
+        self.boxes, self.x, self.y, self.yaw = boxes, x, y, yaw
+        self.path_length = 0.0
+        self.frames = 0
+
+    @property
+    def pose(self) -> tuple[float, float, float]:
+        return self.x, self.y, self.yaw
+
+    def _free(self, x: float, y: float, r: float = 0.2) -> bool:
+        if not (ROOM[0][0] + r <= x <= ROOM[1][0] - r and ROOM[0][1] + r <= y <= ROOM[1][1] - r):
+            return False
+        return not any(b.lo[0] - r <= x <= b.hi[0] + r and b.lo[1] - r <= y <= b.hi[1] + r for b in self.boxes)
+
+    def step(self, action: str) -> bool:
+        if action == "turn_left":
+            self.yaw += math.radians(30)
+            return True
+        if action == "turn_right":
+            self.yaw -= math.radians(30)
+            return True
+        nx, ny = self.x + 0.25 * math.cos(self.yaw), self.y + 0.25 * math.sin(self.yaw)
+        if not self._free(nx, ny):
+            return False
+        self.x, self.y = nx, ny
+        self.path_length += 0.25
+        return True
+
+    def observe(self) -> Frame:
+        self.frames += 1
+        return render(self.boxes, look_at_pose(np.array([self.x, self.y, 1.2]), self.yaw, math.radians(20)), K,
+                      index=self.frames)
+
+
+@pytest.fixture(scope="module")
+def first_map() -> CapNavMap:
+    """Room A recorded from its middle, never looking through the door: room B is unseen."""
+    boxes = _room_a((-0.3, 2.0))
+    frames = []
+    for i, yaw in enumerate(np.radians(np.linspace(55, 305, 24))):
+        for j, eye in enumerate(((-1.2, 0.0), (-1.8, 0.4))):
+            T = look_at_pose(np.array([*eye, 1.2]), float(yaw), math.radians(25))
+            frames.append(render(boxes, T, K, index=2 * i + j))
+    cmap = build_map(frames, detector=create_detector("sim", noise="oracle", seed=0),
+                     encoder=create_encoder("label-embedding", embedder=HashEmbedder()), progress=False)
+    labels = sorted(o.label for o in cmap.objects)
+    assert "lamp" not in labels and labels.count("chair") == 2, labels
+    return cmap
+
+
+def _search(cmap: CapNavMap, world: list[Box], goal: Goal, chosen: object = None, budget: float = 40.0):  # type: ignore[no-untyped-def]
+    agent = BoxAgent(world, -1.2, -0.8, 0.0)
+    s = ObjectSearch(cmap, agent, create_detector("sim", noise="oracle", seed=0), HashEmbedder(),
+                     SearchConfig(budget_m=budget))
+    return agent, s.run(goal, chosen, "test")  # type: ignore[arg-type]
+
+
+def test_object_in_a_room_the_map_never_saw_is_found(first_map: CapNavMap) -> None:
+    world = _room_a((-0.3, 2.0))
+    agent, res = _search(first_map, world, Goal("lamp", "lamp"))
+    assert res.found, res.reason
+    lamp = next(b for b in world if b.category == LAMP)
+    gap = np.maximum(0.0, np.maximum(np.array(lamp.lo[:2]) - agent.pose[:2], np.array(agent.pose[:2]) - lamp.hi[:2]))
+    assert float(np.hypot(*gap)) <= 1.0
+    assert res.steps[0].action == "search" and "not in the map" in res.steps[0].reason
+    assert any("frontier" in s.reason for s in res.steps if s.action == "search")
+    assert res.steps[-1].action == "found" and res.driven_m > 0
+
+
+def test_object_not_where_the_map_says_is_searched_and_found(first_map: CapNavMap) -> None:
+    world = _room_a((1.9, 1.9))  # the blue chair was carried into room B
+    blue = max((o for o in first_map.objects if o.label == "chair"), key=lambda o: o.position[0])
+    agent, res = _search(first_map, world, Goal("chair", "blue chair", ("blue",)), blue)
+    assert res.found and not res.from_map, res.reason
+    assert math.dist(agent.pose[:2], (1.9, 1.9)) <= 1.3
+    text = " | ".join(s.reason for s in res.steps)
+    assert "the map has it" in text and "not at its place" in text
+
+
+def test_budget_running_out_says_so(first_map: CapNavMap) -> None:
+    world = _room_a((-0.3, 2.0))
+    _, res = _search(first_map, world, Goal("bookshelf", "bookshelf"), budget=3.0)
+    assert not res.found
+    assert res.reason.startswith("not found within budget: drove"), res.reason
+    assert res.driven_m <= 3.0 + 0.25
+
+
+def test_search_refuses_a_map_of_a_recording(first_map: CapNavMap, tmp_path: Path) -> None:
+    from typer.testing import CliRunner
+
+    from capnav.cli import app
+    from capnav.core.errors import InputError
+    from capnav.io.mapfile import save_map
+
+    assert "scene_seed" not in first_map.meta  # made from frames, not from capnav sim
+    path = tmp_path / "recorded.capnav"
+    save_map(first_map, path)
+    res = CliRunner().invoke(app, ["navigate", str(path), "the lamp", "--search", "--out", str(tmp_path / "o")])
+    assert isinstance(res.exception, InputError), res.output
+    msg = str(res.exception)
+    assert "--search drives the simulated robot" in msg and "no simulator scene (no scene seed)" in msg
+    assert "drop --search" in msg
