@@ -8,7 +8,9 @@ use); each region is weighed by two cues read from the map alone:
   statistics the room captions use), averaged over the region's room-type posterior given what
   stands in it; a category that table does not know (or a region without room cues) is neutral;
 * its neighbours: how close, in the text embedder's space, the region's objects' labels are to
-  the category (a stool is looked for beside tables and counters). The mean of the three closest.
+  the category (a stool is looked for beside tables and counters): the mean of the three closest,
+  measured above the median similarity of all the map's labels (an embedder finds any two
+  furniture words somewhat alike; only the excess says "usual neighbour").
 
 Each region gives standing points on its open floor (the cell farthest from walls, then more
 points at least ``spacing`` apart in a large region), from which a look around sees the room.
@@ -45,6 +47,7 @@ class PlaceConfig:
     spacing: float = 3.5  # m between standing points of one region (a camera sees ~5 m)
     clearance: float = 0.45  # m a standing point keeps from walls and furniture
     room_weight: float = 0.5  # the room-type cue's share of the prior (the neighbours' the rest)
+    floor: float = 0.25  # prior of a room where nothing speaks for the object: unlikely is not impossible
 
 
 def room_places(cmap: CapNavMap, category: str | None, embedder: TextEmbedder,
@@ -65,6 +68,9 @@ def room_places(cmap: CapNavMap, category: str | None, embedder: TextEmbedder,
     member = np.array([object_region(labels, spec, a, b) for a, b in zip(lo, hi, strict=True)], dtype=np.int64)
     names = [o.label for o in objs]
     sims = _label_similarity(category, names, embedder)
+    if len(sims):
+        base = float(np.median(sims))
+        sims = np.clip((sims - base) / max(1.0 - base, 1e-6), 0.0, 1.0)
     room_term = np.zeros(n)
     neigh = np.zeros(n)
     kinds: list[str] = []
@@ -76,7 +82,7 @@ def room_places(cmap: CapNavMap, category: str | None, embedder: TextEmbedder,
         neigh[k] = float(np.clip(s.mean(), 0.0, 1.0)) if len(s) else 0.0
     if room_term.max() > 0:
         room_term = room_term / room_term.max()
-    prior = cfg.room_weight * room_term + (1.0 - cfg.room_weight) * neigh
+    prior = cfg.floor + (1.0 - cfg.floor) * (cfg.room_weight * room_term + (1.0 - cfg.room_weight) * neigh)
     free = occ.cells == FREE
     clear = ndimage.distance_transform_edt(free) * spec.resolution
     out: list[Place] = []

@@ -52,8 +52,10 @@ class SearchConfig:
     stop_distance: float = 0.8  # m from the sighted goal's centre
     cluster_radius: float = 1.0  # m: goal sightings this close refine the target
     distance_scale: float = 4.0  # m: a place's prior is divided by 1 + path / this
-    frontier_prior: float = 0.35  # prior of unseen space beyond a frontier
-    seen_fraction: float = 0.6  # a region this much seen by the robot's own depth is spent
+    frontier_prior: float = 0.25  # prior of unseen space beyond a frontier of ``frontier_cells`` or more
+    frontier_cells: int = 20  # a smaller frontier (a pocket behind furniture) has a prior in proportion
+    seen_fraction: float = 0.6  # a region looked around in and this much seen by the robot's own depth is spent
+    seen_anyway: float = 0.9  # a region this much seen is spent even if the robot never stood in it
     places: PlaceConfig = field(default_factory=PlaceConfig)
     planner: PlannerConfig = field(default_factory=PlannerConfig)
 
@@ -124,8 +126,9 @@ class ObjectSearch:
         centre = (spec.x0 + 0.5 * spec.cols * spec.resolution, spec.y0 + 0.5 * spec.rows * spec.resolution)
         half = 0.5 * max(spec.cols, spec.rows) * spec.resolution + 3.0
         online = OnlineMap(centre, OnlineMapConfig(resolution=spec.resolution, half_extent=half), cmap.occupancy)
-        self.explorer = FrontierExplorer(agent, detector, ExplorerConfig(planner=cfg.planner, sighting_colours=True),
-                                         online)
+        # A look every 30 degrees: a search must not miss the goal between two views.
+        self.explorer = FrontierExplorer(agent, detector, ExplorerConfig(planner=cfg.planner, sighting_colours=True,
+                                                                         keyframe_turn_deg=30.0), online)
         self.steps: list[SearchStep] = []
         self._odo0 = float(getattr(agent, "path_length", 0.0))
         self._t0 = time.monotonic()
@@ -163,12 +166,14 @@ class ObjectSearch:
         cfg, ex = self.config, self.explorer
         places, regions = room_places(self.cmap, self._goal.category, self.embedder, cfg.places)
         visited: list[tuple[float, float]] = []
+        self._looked_in: set[int] = {self._region_at(regions, ex.xy)}
         while not self._over(None):
             grid = ex.grid()
             cm = ex.costmap(grid)
             cands = [p for p in places if not self._spent(p, visited, regions)]
             fronts = ex.frontiers(grid, cm)
-            cands += [Place(f.target_xy, -1, cfg.frontier_prior, f"a frontier of unseen space ({f.size} cells)")
+            cands += [Place(f.target_xy, -1, cfg.frontier_prior * min(1.0, f.size / cfg.frontier_cells),
+                            f"a frontier of unseen space ({f.size} cells)")
                       for f in fronts if all(math.dist(f.target_xy, v) > ex.config.visited_radius for v in visited)]
             if not cands:
                 return self._end(f"not found: every place worth looking was looked at ({len(visited)} places, "
@@ -185,6 +190,7 @@ class ObjectSearch:
                                 f"{p.prior:.2f}, best of {len(cands)} places", p.xy)
             st = ex.drive_to(p.xy, self._stop)
             visited.append(p.xy)
+            self._looked_in.add(self._region_at(regions, ex.xy))
             if st is Status.BLOCKED:
                 self._log("search", f"could not get to ({p.xy[0]:.2f}, {p.xy[1]:.2f}); giving it up", ex.xy)
             elif not self._over(st) and st is not Status.STOPPED:
@@ -195,8 +201,15 @@ class ObjectSearch:
                 return self._approach(hits, from_map=False)
         return self._out_of_budget()
 
+    def _region_at(self, regions: np.ndarray, xy: tuple[float, float]) -> int:
+        rc = self.cmap.occupancy.spec.to_cell(np.asarray(xy, dtype=np.float64))
+        if not self.cmap.occupancy.spec.inside(rc):
+            return -1
+        return int(regions[rc[0], rc[1]])
+
     def _spent(self, p: Place, visited: Sequence[tuple[float, float]], regions: np.ndarray) -> bool:
-        """Looked from nearby already, or its region mostly seen by the robot's own depth."""
+        """Looked from nearby already, or its region mostly seen by the robot's own depth (from
+        inside it, or nearly all of it from outside: a glimpse through a door is not a look)."""
         if any(math.dist(p.xy, v) < 1.5 for v in visited):
             return True
         mask = regions == p.region
@@ -213,7 +226,8 @@ class ObjectSearch:
         seen = np.zeros(len(xy), bool)
         obs = own.observed()
         seen[inside] = obs[rc[inside, 0], rc[inside, 1]]
-        return float(seen.mean()) >= self.config.seen_fraction
+        frac = float(seen.mean())
+        return frac >= self.config.seen_anyway or (p.region in self._looked_in and frac >= self.config.seen_fraction)
 
     def _path_lengths(self, grid: Any, cm: Any, targets: list[tuple[float, float]]) -> np.ndarray:
         passable = np.isfinite(cm.weights)
