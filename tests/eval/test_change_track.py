@@ -48,10 +48,10 @@ def test_search_counts_only_within_three_walks() -> None:
                              start_xy=(0.0, 0.0), stop_xy=(1.0, 1.0), found=True, retrieval_correct=None,
                              query_time_s=0.0, steps=1, reason="found: ...", success_strict=True)
 
-    short, long = rec(11.9), rec(12.1)
-    _within_budget(short)
-    _within_budget(long)
+    short, long = rec(14.9), rec(15.1)  # the direct path: 4 m to the 1 m region, plus that metre
+    _within_budget(short, 1.0)
+    _within_budget(long, 1.0)
     assert short.success and short.success_strict
-    assert not long.success and long.success_strict is False and long.reason.startswith("reached, but drove 12.1 m")
+    assert not long.success and long.success_strict is False and long.reason.startswith("reached, but drove 15.1 m")
     res = {"summaries": [], "search": {"subgoals": 2, "budget": "3x", "within_budget": 1, "reached_any_length": 2}}
     assert "within 3x 1 of 2, reached at any length 2" in table(res)

@@ -299,12 +299,12 @@ def test_same_seed_same_trajectory(sim: Simulator, embedder) -> None:  # type: i
 
 def test_a_confused_view_is_outvoted_by_the_others(embedder) -> None:  # type: ignore[no-untyped-def]
     """Three views call the object a desk, one calls it a table: 'table' is not accepted there."""
-    from capnav.eval.baselines.explore.object_search import _outvoted
+    from capnav.explore.votes import outvoted
 
     def s(label: str, xy: tuple[float, float], score: float = 0.8) -> Sighting:
         return Sighting(label, score, xy, 0.7, 2.0, 0, (0.0, 0.0))
 
     pool = [s("desk", (2.0, 2.0)), s("desk", (2.1, 2.0)), s("desk", (2.0, 2.1)), s("table", (2.05, 2.05)),
             s("table", (6.0, 1.0))]
-    out = _outvoted([pool[3], pool[4]], pool, GoalMatcher("table", embedder), radius=0.5)
+    out = outvoted([pool[3], pool[4]], pool, GoalMatcher("table", embedder).accepts, radius=0.5)
     assert out.tolist() == [True, False]

@@ -59,6 +59,9 @@ def register(app: typer.Typer) -> None:
                  "capnav-search (visit 1's map and --search, on moved and added objects)")] = None,
         per_class: Annotated[int, typer.Option(min=1, help="with --changes: subgoals per change class and "
                                                            "apartment")] = 8,
+        reuse_maps: Annotated[bool, typer.Option(
+            "--reuse-maps", help="with --changes: load the three maps an earlier run of the same -o saved instead "
+                                 "of making them again (no CPU figures: they were measured by that run)")] = False,
     ) -> None:
         """Run every method on the same apartments, maps and episodes; write results.json and report.md."""
         from capnav.core.console import make_console
@@ -69,7 +72,7 @@ def register(app: typer.Typer) -> None:
 
             check_output_dir(out, "--out")
             ccfg = ChangeTrackConfig(scenes=scenes, seed=seed, changes=ChangeSpec.parse(changes), per_class=per_class,
-                                     width=width, height=height, noise=noise)
+                                     width=width, height=height, noise=noise, reuse_maps=reuse_maps)
             on_interrupt(f"the change track stopped; recordings made so far are kept in {out}/scenes")
             res_c = run_change_track(ccfg, out, progress=progress)
             make_console().print(table(res_c), markup=False, highlight=False)

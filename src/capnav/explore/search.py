@@ -31,6 +31,7 @@ from capnav.explore.explorer import ExplorerConfig, FrontierExplorer, Status
 from capnav.explore.online_map import OnlineMap, OnlineMapConfig
 from capnav.explore.places import Place, PlaceConfig, room_places
 from capnav.explore.sighting import Sighting
+from capnav.explore.votes import outvoted
 from capnav.language.embedder import TextEmbedder
 from capnav.mapping.cmap import CapNavMap, MapObject
 from capnav.planning import PlannerConfig
@@ -47,10 +48,11 @@ class SearchConfig:
     goal_score: float = 0.55  # detector confidence a goal sighting needs
     label_match: float = 0.6  # label-goal cosine when the goal names no known category
     at_place: float = 1.0  # m: a goal sighting this close to the map object's box confirms it
-    known_margin: float = 0.4  # m: a sighting inside another same-label object's box plus this is that object
+    known_margin: float = 0.4  # m: a sighting inside another same-label object's box plus this, in its colours, is it
     colour_distance: float = 20.0  # CIEDE2000 (kL 2) within which a seen colour is the goal's colour word
     stop_distance: float = 0.8  # m from the sighted goal's centre
     cluster_radius: float = 1.0  # m: goal sightings this close refine the target
+    vote_radius: float = 0.5  # m: a goal sighting outvoted by other labels this close is a confusion
     distance_scale: float = 4.0  # m: a place's prior is divided by 1 + path / this
     frontier_prior: float = 0.25  # prior of unseen space beyond a frontier of ``frontier_cells`` or more
     frontier_cells: int = 20  # a smaller frontier (a pocket behind furniture) has a prior in proportion
@@ -133,6 +135,7 @@ class ObjectSearch:
         self._odo0 = float(getattr(agent, "path_length", 0.0))
         self._t0 = time.monotonic()
         self._timed_out = False
+        self._object_colours: dict[int, list[tuple[float, float, float]]] = {}
 
     # ------------------------------------------------------------------ the request
     def run(self, goal: Goal, chosen: MapObject | None, map_reason: str) -> SearchResult:
@@ -248,22 +251,32 @@ class ObjectSearch:
     # ------------------------------------------------------------------ the goal in view
     def _hits(self, pool: Sequence[Sighting]) -> list[Sighting]:
         """Sightings that show the goal: its category (or a label close to its phrase) seen with
-        enough confidence, in its colour when it names one, and not another object the map holds."""
+        enough confidence, not outvoted by the other labels seen at that spot, in its colour when it
+        names one, and not another object the map holds."""
         cfg, g = self.config, self._goal
         good = [s for s in pool if s.score >= cfg.goal_score]
         if not good:
             return []
-        if g.category is not None:
-            good = [s for s in good if s.label == g.category]
-        else:
-            labels = sorted({s.label for s in good})
-            vecs = self.embedder.embed([g.phrase, *labels]).astype(np.float64)
-            vecs /= np.maximum(np.linalg.norm(vecs, axis=1, keepdims=True), 1e-9)
-            ok = {lab for lab, c in zip(labels, vecs[1:] @ vecs[0], strict=True) if c >= cfg.label_match}
-            good = [s for s in good if s.label in ok]
+        good = [s for s, ok in zip(good, self._is_goal([s.label for s in good]), strict=True) if ok]
+        if good and cfg.vote_radius > 0:
+            out = outvoted(good, self.explorer.sightings, self._is_goal, cfg.vote_radius)
+            good = [s for s, o in zip(good, out, strict=True) if not o]
         if g.colours:
             good = [s for s in good if self._colour_ok(s)]
         return [s for s in good if not self._known_other(s)]
+
+    def _is_goal(self, labels: list[str]) -> np.ndarray:
+        """Which detector labels are the goal: its category, or labels close to its phrase."""
+        g = self._goal
+        if g.category is not None:
+            return np.array([lab == g.category for lab in labels], bool)
+        uniq = sorted(set(labels))
+        if not uniq:
+            return np.zeros(0, bool)
+        vecs = self.embedder.embed([g.phrase, *uniq]).astype(np.float64)
+        vecs /= np.maximum(np.linalg.norm(vecs, axis=1, keepdims=True), 1e-9)
+        ok = {lab for lab, c in zip(uniq, vecs[1:] @ vecs[0], strict=True) if c >= self.config.label_match}
+        return np.array([lab in ok for lab in labels], bool)
 
     def _colour_ok(self, s: Sighting) -> bool:
         from capnav.language.colors import color_distance, color_lab
@@ -274,16 +287,30 @@ class ObjectSearch:
         return any(color_distance(w, lab) <= self.config.colour_distance for w in words for lab in s.colours)
 
     def _known_other(self, s: Sighting) -> bool:
-        """The sighting lies on a map object of its label that is not the stale answer: the map
-        already holds that one, and ranked it below the goal (or the goal is not in the map)."""
+        """The sighting lies on a map object of its label, in that object's colours, that is not
+        the stale answer: the map already holds that one, and ranked it below the goal (or the goal
+        is not in the map). Another colour there is something new standing where that one stood."""
         m = self.config.known_margin
         for o in self.cmap.objects:
             if o.label != s.label or (self._stale is not None and o.id == self._stale.id):
                 continue
             if (o.extent_min[0] - m <= s.xy[0] <= o.extent_max[0] + m
-                    and o.extent_min[1] - m <= s.xy[1] <= o.extent_max[1] + m):
+                    and o.extent_min[1] - m <= s.xy[1] <= o.extent_max[1] + m) and self._looks_like(s, o):
                 return True
         return False
+
+    def _looks_like(self, s: Sighting, o: MapObject) -> bool:
+        from capnav.core.colour import ciede2000
+        from capnav.language.colors import object_colors
+
+        if o.id not in self._object_colours:
+            cols = object_colors(np.asarray(o.colors).reshape(-1, 3)) if len(o.colors) else []
+            self._object_colours[o.id] = [c.lab for c in cols if c.fraction >= 0.2]
+        mine = self._object_colours[o.id]
+        if not mine or not s.colours:
+            return True  # nothing to tell them apart by
+        d = min(float(ciede2000(np.asarray(a), np.asarray(b), kL=2.0)) for a in s.colours for b in mine)
+        return d <= self.config.colour_distance
 
     def _at(self, s: Sighting, o: MapObject) -> bool:
         m = self.config.at_place

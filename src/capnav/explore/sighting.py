@@ -33,7 +33,8 @@ def lift(frame: Frame, detections: Sequence[Detection], min_points: int = 10,
          max_distance: float = 6.0, colours: bool = False) -> list[Sighting]:
     """Sightings of ``detections`` with enough valid depth in their masks; others are dropped
     (a mask over invalid depth gives no place to go). ``colours``: also the mask pixels' dominant
-    colours (clusters with at least a fifth of the pixels), for a goal that names a colour."""
+    colours (the largest cluster, and any other with over a third of the pixels: a highlight or
+    a strip of legs is not the object's colour), for a goal that names a colour."""
     out: list[Sighting] = []
     cam = np.asarray(frame.T_wc, dtype=np.float64)[:3, 3]
     for d in detections:
@@ -48,7 +49,8 @@ def lift(frame: Frame, detections: Sequence[Detection], min_points: int = 10,
         if colours:
             from capnav.language.colors import object_colors
 
-            labs = tuple(k.lab for k in object_colors(frame.rgb[d.mask].reshape(-1, 3)) if k.fraction >= 0.2)
+            cols = object_colors(frame.rgb[d.mask].reshape(-1, 3))
+            labs = tuple(k.lab for i, k in enumerate(cols) if i == 0 or k.fraction > 1 / 3)
         out.append(Sighting(d.label, float(d.score), (float(c[0]), float(c[1])), float(c[2]), dist,
                             int(frame.index), (float(cam[0]), float(cam[1])), labs))
     return out

@@ -27,6 +27,7 @@ from capnav.eval.method import Agent, SceneContext, SubgoalOutcome
 from capnav.explore.explorer import ExplorerConfig, FrontierExplorer, Status
 from capnav.explore.frontier import Frontier
 from capnav.explore.sighting import Sighting
+from capnav.explore.votes import outvoted
 from capnav.planning import PlannerConfig
 
 
@@ -95,7 +96,7 @@ class ObjectSearch(ABC):
             ok = matcher.accepts([s.label for s in good]) if good else np.zeros(0, bool)
             hits = [s for s, a in zip(good, ok, strict=True) if a]
             if hits and cfg.vote_radius > 0:
-                out = _outvoted(hits, ex.sightings if voters is None else voters, matcher, cfg.vote_radius)
+                out = outvoted(hits, ex.sightings if voters is None else voters, matcher.accepts, cfg.vote_radius)
                 hits = [s for s, o in zip(hits, out, strict=True) if not o]
             self._decision_time += time.perf_counter() - t0
             return hits
@@ -156,18 +157,3 @@ class ObjectSearch(ABC):
             **(extra or {})}
         return SubgoalOutcome(found=found, reason=reason, target_xy=target_xy, query_time_s=self._decision_time,
                               steps=ex.steps, explanation=self.describe_choice(), extra=info)
-
-
-def _outvoted(cands: Sequence[Sighting], pool: Sequence[Sighting], matcher: GoalMatcher, radius: float
-              ) -> NDArray[np.bool_]:
-    """For each candidate goal sighting: do the sightings within ``radius`` of it, weighted by
-    confidence, vote more for other labels than for the goal? (A detector that confuses a desk
-    with a table does so in a minority of views; one confused view should not send the agent.)"""
-    pxy = np.array([s.xy for s in pool], dtype=np.float64).reshape(-1, 2)
-    w = np.array([s.score for s in pool], dtype=np.float64)
-    is_goal = matcher.accepts([s.label for s in pool])
-    cxy = np.array([s.xy for s in cands], dtype=np.float64).reshape(-1, 2)
-    near = ((cxy[:, None, :] - pxy[None, :, :]) ** 2).sum(-1) <= radius**2  # (C, P)
-    for_goal = (near * (w * is_goal)[None, :]).sum(axis=1)
-    against = (near * (w * ~is_goal)[None, :]).sum(axis=1)
-    return np.asarray(against > for_goal)
