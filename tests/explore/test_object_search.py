@@ -125,6 +125,16 @@ def test_object_not_where_the_map_says_is_searched_and_found(first_map: CapNavMa
     assert "the map has it" in text and "not at its place" in text
 
 
+def test_a_new_colour_where_a_known_object_stood_is_not_that_object(first_map: CapNavMap) -> None:
+    """The red chair was thrown out and the blue one set down exactly there: a blue chair seen on
+    the map's red chair is the blue one, not the red one the map holds."""
+    world = [b for b in _room_a((-2.25, -0.05)) if b.color != RED]
+    blue = max((o for o in first_map.objects if o.label == "chair"), key=lambda o: o.position[0])
+    agent, res = _search(first_map, world, Goal("chair", "blue chair", ("blue",)), blue)
+    assert res.found and not res.from_map, res.reason
+    assert math.dist(agent.pose[:2], (-2.25, -0.05)) <= 1.3
+
+
 def test_budget_running_out_says_so(first_map: CapNavMap) -> None:
     world = _room_a((-0.3, 2.0))
     _, res = _search(first_map, world, Goal("bookshelf", "bookshelf"), budget=3.0)
