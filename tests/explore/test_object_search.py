@@ -110,7 +110,7 @@ def test_object_in_a_room_the_map_never_saw_is_found(first_map: CapNavMap) -> No
     lamp = next(b for b in world if b.category == LAMP)
     gap = np.maximum(0.0, np.maximum(np.array(lamp.lo[:2]) - agent.pose[:2], np.array(agent.pose[:2]) - lamp.hi[:2]))
     assert float(np.hypot(*gap)) <= 1.0
-    assert res.steps[0].action == "search" and "not in the map" in res.steps[0].reason
+    assert res.steps[0].action == "look" and res.steps[1].action == "search" and "not in the map" in res.steps[1].reason
     assert any("frontier" in s.reason for s in res.steps if s.action == "search")
     assert res.steps[-1].action == "found" and res.driven_m > 0
 
@@ -133,6 +133,16 @@ def test_a_new_colour_where_a_known_object_stood_is_not_that_object(first_map: C
     agent, res = _search(first_map, world, Goal("chair", "blue chair", ("blue",)), blue)
     assert res.found and not res.from_map, res.reason
     assert math.dist(agent.pose[:2], (-2.25, -0.05)) <= 1.3
+
+
+def test_the_goal_beside_the_robot_is_seen_before_it_leaves(first_map: CapNavMap) -> None:
+    """The blue chair now stands beside the start, the map has it across the room: the robot looks
+    around first and goes to the one it sees, not to the map's place."""
+    world = _room_a((-0.2, -1.4))
+    blue = max((o for o in first_map.objects if o.label == "chair"), key=lambda o: o.position[0])
+    agent, res = _search(first_map, world, Goal("chair", "blue chair", ("blue",)), blue)
+    assert res.found and res.driven_m <= 1.5, res.reason
+    assert [s.action for s in res.steps][:2] == ["look", "found"]
 
 
 def test_budget_running_out_says_so(first_map: CapNavMap) -> None:

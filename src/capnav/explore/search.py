@@ -139,12 +139,21 @@ class ObjectSearch:
 
     # ------------------------------------------------------------------ the request
     def run(self, goal: Goal, chosen: MapObject | None, map_reason: str) -> SearchResult:
-        """Go to ``chosen`` (the map's answer, None when it has none) and confirm it, else search."""
+        """Look around, go to ``chosen`` (the map's answer, None when it has none) and confirm it,
+        else search."""
         cfg, ex = self.config, self.explorer
         ex.begin(10**9)
         ex.path_limit = self._odo0 + cfg.budget_m
         self._goal = goal
         self._stale = chosen
+        # Look before leaving: turning in place costs no distance, and the goal may stand right here.
+        self._log("look", "looking around where the request was heard", ex.xy)
+        ex.observe()
+        if not self._stop(ex):
+            ex.look_around(self._stop)
+        hits = self._hits(ex.sightings)
+        if hits:
+            return self._approach(hits, from_map=chosen is not None and any(self._at(s, chosen) for s in hits))
         if chosen is not None:
             cxy = (float(chosen.position[0]), float(chosen.position[1]))
             self._log("map", f"the map has it: object {chosen.id} ({chosen.caption or chosen.label}) at "
@@ -344,7 +353,7 @@ class ObjectSearch:
         st = ex.approach(target, cfg.stop_distance, self._budget_only)
         goal_xy = target()
         d = math.dist(ex.xy, goal_xy)
-        if st is Status.ARRIVED:
+        if st is Status.ARRIVED or d <= cfg.planner.reach:
             return self._end(f"found: {self._goal.what} seen at ({goal_xy[0]:.2f}, {goal_xy[1]:.2f}); stopped "
                              f"{d:.2f} m from it", True, goal_xy, from_map)
         if self._over(st):
