@@ -298,7 +298,8 @@ class ObjectSearch:
     def _known_other(self, s: Sighting) -> bool:
         """The sighting lies on a map object of its label, in that object's colours, that is not
         the stale answer: the map already holds that one, and ranked it below the goal (or the goal
-        is not in the map). Another colour there is something new standing where that one stood."""
+        is not in the map). Another main colour there is something new standing where that one
+        stood (compared by the largest colour of each: a black chair is not a red one with black legs)."""
         m = self.config.known_margin
         for o in self.cmap.objects:
             if o.label != s.label or (self._stale is not None and o.id == self._stale.id):
@@ -314,11 +315,11 @@ class ObjectSearch:
 
         if o.id not in self._object_colours:
             cols = object_colors(np.asarray(o.colors).reshape(-1, 3)) if len(o.colors) else []
-            self._object_colours[o.id] = [c.lab for c in cols if c.fraction >= 0.2]
+            self._object_colours[o.id] = [c.lab for c in cols[:1]]
         mine = self._object_colours[o.id]
         if not mine or not s.colours:
             return True  # nothing to tell them apart by
-        d = min(float(ciede2000(np.asarray(a), np.asarray(b), kL=2.0)) for a in s.colours for b in mine)
+        d = float(ciede2000(np.asarray(s.colours[0]), np.asarray(mine[0]), kL=2.0))
         return d <= self.config.colour_distance
 
     def _at(self, s: Sighting, o: MapObject) -> bool:

@@ -25,7 +25,8 @@ class Sighting:
     distance: float  # camera centre to that point (m)
     frame_index: int
     camera_xy: tuple[float, float]
-    #: CIELAB of the mask's dominant colours, largest share first (only when lifted with ``colours``).
+    #: CIELAB of the mask's colours with a fifth of its pixels or more, largest share first (only
+    #: when lifted with ``colours``).
     colours: tuple[tuple[float, float, float], ...] = ()
 
 
@@ -33,8 +34,8 @@ def lift(frame: Frame, detections: Sequence[Detection], min_points: int = 10,
          max_distance: float = 6.0, colours: bool = False) -> list[Sighting]:
     """Sightings of ``detections`` with enough valid depth in their masks; others are dropped
     (a mask over invalid depth gives no place to go). ``colours``: also the mask pixels' dominant
-    colours (the largest cluster, and any other with over a third of the pixels: a highlight or
-    a strip of legs is not the object's colour), for a goal that names a colour."""
+    colours (clusters of at least a fifth of the pixels, the largest first: "the plant in the
+    blue pot" names a part), for a goal that names a colour."""
     out: list[Sighting] = []
     cam = np.asarray(frame.T_wc, dtype=np.float64)[:3, 3]
     for d in detections:
@@ -50,7 +51,7 @@ def lift(frame: Frame, detections: Sequence[Detection], min_points: int = 10,
             from capnav.language.colors import object_colors
 
             cols = object_colors(frame.rgb[d.mask].reshape(-1, 3))
-            labs = tuple(k.lab for i, k in enumerate(cols) if i == 0 or k.fraction > 1 / 3)
+            labs = tuple(k.lab for i, k in enumerate(cols) if i == 0 or k.fraction >= 0.2)
         out.append(Sighting(d.label, float(d.score), (float(c[0]), float(c[1])), float(c[2]), dist,
                             int(frame.index), (float(cam[0]), float(cam[1])), labs))
     return out
