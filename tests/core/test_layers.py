@@ -1,7 +1,8 @@
 """The import rules of the package layout (README, "Layout"), checked on the source with ``ast``:
 every ``import`` counts, at module level, inside functions and under ``TYPE_CHECKING``.
 
-- the stages that see observations only (perception, io, mapping, language, retrieval, planning)
+- the stages that see observations only (perception, io, mapping, language, retrieval, planning,
+  explore)
   import neither the simulator (``sim``: the scene truth) nor the evaluation (``eval``), nor
   anything built on top of them;
 - ``core`` imports only ``core``; ``sim`` (the world) imports no stage that builds or reads maps;
@@ -17,9 +18,9 @@ from collections.abc import Iterator
 from pathlib import Path
 
 SRC = Path(__file__).resolve().parents[2] / "src"
-TOP = ("api", "cli", "core", "demo", "eval", "io", "language", "mapping", "perception", "pipeline", "planning",
-       "retrieval", "serve", "sim", "viz")
-OBSERVATION_STAGES = ("perception", "io", "mapping", "language", "retrieval", "planning")
+TOP = ("api", "cli", "core", "demo", "eval", "explore", "io", "language", "mapping", "perception", "pipeline",
+       "planning", "retrieval", "serve", "sim", "viz")
+OBSERVATION_STAGES = ("perception", "io", "mapping", "language", "retrieval", "planning", "explore")
 ABOVE = ("eval", "pipeline", "demo", "cli", "serve", "api")
 FORBIDDEN: dict[str, tuple[str, ...]] = {
     **{stage: ("sim", *ABOVE) for stage in OBSERVATION_STAGES},
