@@ -227,6 +227,7 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
     centres = spec.to_world(rc)
     cost = field[win].ravel() * spec.resolution
     reach_ok = np.isfinite(cost)
+    cut_off = int((within & ~reach_ok).sum())  # free floor within reach that no path gets to
     within &= reach_ok
     near &= reach_ok
     seen = np.zeros(len(rc), dtype=bool)
@@ -269,9 +270,14 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
     if not ok_all.any():  # stay where the robot stands rather than stop on floor nobody saw
         xy = spec.to_world(np.asarray(s_cell))
         d0 = float(_distances(xy.reshape(1, 2), fp)[0])
-        return _pose(np.asarray(s_cell), xy, fp, d0 <= cfg.reach,
-                     f"no seen free cell is reachable from the start (only unknown space); staying {d0:.2f} m "
-                     "from the object", d0, 0.0, None, None)
+        # Say which it is: the floor within reach was never seen, or the caller ruled out the seen
+        # floor it can get to (cells the agent failed to get to, a relaxed level's tight cells).
+        ruled_out = bool((np.isfinite(field) & (cm.occ.cells == FREE) & ~may).any())
+        why = ("every reachable cell of seen free floor is ruled out as a goal (cells the robot could not get to, "
+               "or too tight for it)" if ruled_out else
+               "no seen free cell is reachable from the start (only unknown space)")
+        return _pose(np.asarray(s_cell), xy, fp, d0 <= cfg.reach, f"{why}; staying {d0:.2f} m from the object",
+                     d0, 0.0, None, None)
     r_all = np.argwhere(ok_all)
     c_all = spec.to_world(r_all)
     d_all = _distances(c_all, fp)
@@ -281,6 +287,11 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
     i = int(nearest[np.argmin(cost_all[nearest])])
     why = (f"no reachable free cell within {cfg.reach:.2f} m of the object; closest reachable cell is "
            f"{d_all[i]:.2f} m away")
+    if cut_off:
+        # Free floor beside the object exists, walled off from the robot on the map: a shut door
+        # reads as wall, so does a gap narrower than the robot.
+        why += (f" (the free floor within reach of it, {cut_off * spec.resolution ** 2:.2f} m^2, is not connected "
+                "to where the robot stands on the map: a closed door or a gap narrower than the robot)")
     return _pose(r_all[i], c_all[i], fp, False, why, float(d_all[i]), float(cost_all[i]), None, None)
 
 
