@@ -142,3 +142,35 @@ def test_unreachable_and_missing_start(described: tuple[Path, CapNavMap], tmp_pa
     old = CapNavMap(cmap.objects, cmap.voxels, cmap.occupancy, cmap.meta, cmap.caches, trajectory=None)
     with pytest.raises(InputError, match=r"records no camera path .* pass --start"):
         navigate_on_map(old, _retriever(old), "the sofa")
+
+
+def test_a_sequence_through_a_closed_door_stops_at_that_leg_with_the_reason(
+        described: tuple[Path, CapNavMap], tmp_path: Path) -> None:
+    path, _ = described
+    # A wall closes off the room's south-east quarter, where the lamp stands (more than the reach
+    # from the wall); its doorway (y -2.1 to -1.3 m) is open in one map and shut in the other (a
+    # closed door reads as wall).
+    maps = {}
+    for state in ("open", "shut"):
+        cmap = load_map(path)
+        spec = cmap.occupancy.spec
+        rr, cc = np.mgrid[0:spec.rows, 0:spec.cols]
+        xy = spec.to_world(np.stack([rr, cc], axis=-1))
+        x, y = xy[..., 0], xy[..., 1]
+        wall = ((np.abs(x - 1.0) < 0.05) & (y < -0.9)) | ((np.abs(y + 0.9) < 0.05) & (x > 1.0))
+        if state == "open":
+            wall &= ~((np.abs(x - 1.0) < 0.05) & (y > -2.1) & (y < -1.3))
+        cmap.occupancy.cells[wall] = OCCUPIED
+        maps[state] = tmp_path / f"{state}.capnav"
+        save_map(cmap, maps[state])
+    text = "go to the sofa, then the lamp"
+    args = ["--start", "-1.5,0.5", "--through-unknown"]
+    res = CliRunner().invoke(app, ["navigate", str(maps["open"]), text, "--out", str(tmp_path / "o"), *args])
+    assert res.exit_code == 0, res.output
+    res = CliRunner().invoke(app, ["navigate", str(maps["shut"]), text, "--out", str(tmp_path / "s"), *args])
+    assert res.exit_code == 1 and "goal 2 of 2" in res.output and "no plan" in res.output
+    rec = json.loads((tmp_path / "s" / "navigate.json").read_text())
+    assert rec["ok"] is False and [leg["ok"] for leg in rec["legs"]] == [True, False]
+    lamp = rec["legs"][1]
+    assert lamp["retrieval"]["chosen"]["label"] == "lamp"  # the right object, walled off
+    assert "out of reach" in lamp["reason"] and "not connected to where the robot stands" in lamp["reason"]
