@@ -18,9 +18,10 @@ from capnav.sim import SceneManifest, Simulator
 from capnav.sim.changes import MIN_MOVE, ChangeSpec
 
 TINY = ["--seed", "2", "--frames", "6", "--width", "64", "--height", "48", "--rooms", "3"]
-# sha256 over (sha256 of every file, in path order) of `capnav sim` + TINY, computed with the code before
-# later visits existed: a first visit must stay that dataset byte for byte.
-VISIT1_DIGEST = "332f37b51f16f058b553707b1ab9b818a2f7afc6f7b8ed213b377dda6f7d5b7e"
+# sha256 over (sha256 of every file, in path order) of `capnav sim` + TINY: a first visit must stay
+# today's dataset byte for byte. Recomputed when the exploration came to take an object's views from
+# points that see it (sim/explore.py), which moved some of its viewpoints.
+VISIT1_DIGEST = "9bd79184933985563707602598afd48c234e76087df1afec00c6da0e54d12213"
 
 
 def _digest(folder: Path) -> str:

@@ -49,3 +49,27 @@ def test_exploration_is_deterministic_and_capped(small_sim: Simulator) -> None:
         ExploreConfig(stride=0)
     with pytest.raises(InputError):
         ExploreConfig(max_frames=0)
+
+
+def test_an_objects_view_is_taken_from_a_point_that_sees_it() -> None:
+    from types import SimpleNamespace
+
+    from capnav.core.grid import GridSpec
+    from capnav.sim.explore import _in_sight
+    from capnav.sim.sightline import WALL, SightGrid
+
+    # A 4 x 4 m room; a wardrobe-high screen at x = 2 m from y = 0 to 3 m hides a lamp in the
+    # south-east corner from everything west of it but the north strip.
+    spec = GridSpec(0.0, 0.0, 0.05, 80, 80)
+    labels = np.zeros((80, 80), np.int32)
+    labels[0:60, 40] = WALL
+    sight = SightGrid(spec, labels)
+    lamp = SimpleNamespace(id=7, footprint=lambda: np.array([[3.5, 0.3], [3.8, 0.3], [3.8, 0.6], [3.5, 0.6]]))
+    pts = np.array([[1.0, 0.5], [1.2, 1.5], [1.0, 3.6], [3.0, 2.0]])  # the last two see it
+    d = np.hypot(pts[:, 0] - 3.65, pts[:, 1] - 0.45)
+    assert not sight.sees(pts[0], lamp.footprint(), own_ids=(7,))
+    chosen = _in_sight(sight, pts, d, 2.5, 0, lamp)  # type: ignore[arg-type]
+    assert chosen in (2, 3) and sight.sees(pts[chosen], lamp.footprint(), own_ids=(7,))
+    assert _in_sight(sight, pts, d, 2.5, 3, lamp) == 3  # a drawn point in sight stays  # type: ignore[arg-type]
+    # nothing sees it: the drawn point (a view is still taken)
+    assert _in_sight(sight, pts[:2], d[:2], 2.5, 1, lamp) == 1  # type: ignore[arg-type]

@@ -4,7 +4,8 @@ Nothing here reads the scene manifest. The category comes from the object's labe
 detector's hint may be wrong, so the vote winner is used, not the last label); colours from its
 fused point colours, or from its views' pixels when it has few points (``colors.object_colors``);
 size in metres and relative to the other instances of its category; shape cues from its
-top-down footprint; neighbours and room from ``SceneContext``.
+top-down footprint; neighbours and room from ``SceneContext``. A lamp's colour and surface are its
+shade's (the top of its points), as a plant is told apart by its pot.
 """
 
 from __future__ import annotations
@@ -45,6 +46,7 @@ class OfflineCaptionConfig:
     form: FormConfig = field(default_factory=FormConfig)  # shape words from the points
     surface: SurfaceConfig = field(default_factory=SurfaceConfig)  # weave and grain from the pixels
     base_fraction: float = 0.3  # lowest share of the height that holds a plant's pot
+    shade_fraction: float = 0.3  # highest share of the height that holds a lamp's shade
 
 
 def vote_label(obj: MapObject) -> str:
@@ -80,18 +82,36 @@ SURFACE_WORDS = {"woven": "fabric", "grainy": "grainy", "plain": "smooth"}
 #: Categories that grow (foliage over a pot).
 _GROWING = {"plant"}
 
+#: Categories whose colour is their top's: a lamp is called by its shade ("the white lamp" with a
+#: grey pole and foot), so the stand's colour, the same on every lamp, does not make them alike.
+_SHADED = {"lamp"}
+
 
 class ObservationCaptioner(Captioner):
     """Writes "NAME, one sentence" from the map's observations (no model, deterministic)."""
 
-    model_id = "offline-observation-v4"  # v2: surface, rectangular and growth words; v3: "leafy", not "bushy";
-    # v4: grainy / smooth surfaces
+    model_id = "offline-observation-v5"  # v2: surface, rectangular and growth words; v3: "leafy", not "bushy";
+    # v4: grainy / smooth surfaces; v5: a lamp's colour and surface are its shade's
 
     def __init__(self, config: OfflineCaptionConfig | None = None) -> None:
         self.config = config or OfflineCaptionConfig()
 
+    def own_colors(self, obj: MapObject) -> NDArray[np.uint8]:
+        """The fused point colours that say the object's colour: a lamp's shade's (its points in the
+        top ``shade_fraction`` of its height) when enough were fused there, else all of them."""
+        rgb = np.asarray(obj.colors).reshape(-1, 3)
+        if vote_label(obj) not in _SHADED:
+            return rgb
+        pts = np.asarray(obj.points).reshape(-1, 3)
+        if len(pts) != len(rgb) or len(pts) < self.config.min_points:
+            return rgb
+        z = pts[:, 2]
+        lo, hi = float(z.min()), float(z.max())
+        top = rgb[z >= hi - self.config.shade_fraction * max(hi - lo, 1e-6)]
+        return top if len(top) >= self.config.min_points else rgb
+
     def colors(self, obj: MapObject) -> list[ColorCluster]:
-        rgb = np.asarray(obj.colors)
+        rgb = self.own_colors(obj)
         if len(rgb) < self.config.min_points:
             px = view_pixels(obj)
             if len(px) > len(rgb):
@@ -113,7 +133,7 @@ class ObservationCaptioner(Captioner):
         """Weave and grain from the views' pixels around the object's median observed colour."""
         from capnav.language.colors import srgb_to_lab
 
-        rgb = np.asarray(obj.colors).reshape(-1, 3)
+        rgb = self.own_colors(obj)  # a lamp's surface is its shade's
         if len(rgb) < self.config.min_points:
             px = view_pixels(obj)
             rgb = px if len(px) > len(rgb) else rgb

@@ -1,5 +1,6 @@
 """A virtual exploration pass (the paper's posed RGB-D collection): visit every room, look around at
-a few spots, look at every object from several distances, walk between stops on shortest paths.
+a few spots, look at every object from several distances (from points that see it past walls and
+tall furniture), walk between stops on shortest paths.
 
 The policy reads the scene truth to choose viewpoints (it is part of the simulator, like a scripted
 data-collection run); the frames it yields are plain observations.
@@ -17,6 +18,8 @@ from numpy.typing import NDArray
 from capnav.core.errors import InputError
 from capnav.core.frame import Frame
 from capnav.core.geometry import look_at_pose
+from capnav.sim.apartment import SceneObject
+from capnav.sim.sightline import SightGrid, sight_grid
 from capnav.sim.simulator import Simulator
 
 
@@ -62,11 +65,13 @@ def plan_exploration(sim: Simulator, cfg: ExploreConfig) -> list[NDArray[np.floa
 
 def _plan(sim: Simulator, cfg: ExploreConfig) -> list[NDArray[np.float64]]:
     rng = np.random.default_rng([cfg.seed, sim.seed, 7])
+    extra = np.random.default_rng([cfg.seed, sim.seed, 8])  # the extra views' own draws: the others stay
     grid = sim.nav_grid()
     pts = grid.free_points()
     apt = sim.apartment
     cam_h = sim.config.agent.camera_height
     order = _room_order(sim)
+    sight = sight_grid(apt, grid.spec)  # walls and tall furniture: a view of an object must see it
     poses: list[NDArray[np.float64]] = []
     pos: NDArray[np.float64] | None = None
     for k in order:
@@ -76,16 +81,24 @@ def _plan(sim: Simulator, cfg: ExploreConfig) -> list[NDArray[np.float64]]:
             continue
         # stops: (x, y, look) where look is None for a look-around, or the (x, y, z) to look at
         stops: list[tuple[float, float, tuple[float, float, float] | None]] = []
-        for s in _spread_points(inroom, grid, max(1, min(4, round(r.area / cfg.spot_area))), rng):
+        spots = _spread_points(inroom, grid, max(1, min(4, round(r.area / cfg.spot_area))), rng)
+        for s in spots:
             stops.append((float(s[0]), float(s[1]), None))
         for o in (o for o in apt.objects if o.room == k):
             target = (o.x, o.y, min(o.model.size[2] * 0.6, cam_h))
             d = np.hypot(inroom[:, 0] - o.x, inroom[:, 1] - o.y)
-            for dist in cfg.view_distances:
+            dists = cfg.view_distances
+            if not any(sight.sees(s, o.footprint(), own_ids=(o.id,)) for s in spots):
+                # Hidden from every look-around spot (tucked behind a wardrobe), its own views are all
+                # it gets: one more, so that a track can be born (the tracker wants three hits).
+                dists = (*dists, float(np.mean(dists)))
+            for n, dist in enumerate(dists):
                 near = np.flatnonzero(np.abs(d - dist) < 0.35)
                 if len(near) == 0:
                     near = np.array([int(np.argmin(np.abs(d - dist)))])
-                p = inroom[int(near[int(rng.integers(len(near)))])]
+                draw = rng if n < len(cfg.view_distances) else extra
+                j = int(near[int(draw.integers(len(near)))])
+                p = inroom[_in_sight(sight, inroom, d, dist, j, o)]
                 stops.append((float(p[0]), float(p[1]), target))
         # visit stops nearest-first from where we are
         remaining = list(range(len(stops)))
@@ -112,6 +125,26 @@ def _plan(sim: Simulator, cfg: ExploreConfig) -> list[NDArray[np.float64]]:
                 pitch = -math.atan2(dz, math.hypot(dx, dy))
                 poses.append(look_at_pose(eye, yaw, pitch))
     return poses
+
+
+#: How many view points, nearest the wanted distance first, are tried for one in sight of the object.
+SIGHT_TRIES = 64
+
+
+def _in_sight(sight: SightGrid, pts: NDArray[np.float64], d: NDArray[np.float64], dist: float, drawn: int,
+              obj: SceneObject) -> int:
+    """The view point of ``obj`` from ``pts`` (distances ``d`` to it): the ``drawn`` one when it sees
+    the object, else the one nearest the wanted ``dist`` that does (a view from behind the wardrobe
+    shows the wardrobe), else the drawn one."""
+    fp = obj.footprint()
+    if sight.sees(pts[drawn], fp, own_ids=(obj.id,)):
+        return drawn
+    order = np.argsort(np.abs(d - dist), kind="stable")
+    # the points nearest the wanted distance, then a spread over the whole room (nearer or farther)
+    for i in np.concatenate([order[:SIGHT_TRIES], order[SIGHT_TRIES::max(1, len(order) // SIGHT_TRIES)]]):
+        if sight.sees(pts[int(i)], fp, own_ids=(obj.id,)):
+            return int(i)
+    return drawn
 
 
 def explore(sim: Simulator, cfg: ExploreConfig | None = None) -> Iterator[Frame]:
