@@ -76,6 +76,17 @@ is spoken to):
   that every indoor class is reachable by its everyday names ("mug", "rucksack", "mobile phone",
   "paperback"), chosen like the categories' forms.
 
+- ``kinds``: words for a kind of several categories -> those categories ("appliance": the
+  refrigerator, the stove and the washing machine; "plumbing fixture": the sink and the toilet;
+  "furniture"), WordNet's artifact synsets above two
+  categories or more (``_kinds`` says which are left out), so that "the appliance on your left"
+  is asked of every category it covers, each as the named one.
+
+- ``placing``: verbs of putting a thing down on a support ("put", "set down", "rest", "plonk":
+  ``PLACING_SENSES`` and ``PLACING_TREES``), so that "somewhere to rest my cup" asks for a surface
+  rather than for what the cup is kept in; ``body``: nouns for parts of the body (noun.body) with
+  their plurals, so that "somewhere to rest my feet" rests the person.
+
 WordNet's licence notice is copied beside the data (``WORDNET_LICENSE``).
 """
 
@@ -180,6 +191,9 @@ def build(wordnet: Path) -> dict[str, Any]:
         out["growth"] = _growth(wn, out["forms"])
         out["labels"] = _labels(wn, out["forms"])
         out["persons"] = _persons(wn, (wordnet / "noun.exc").read_text().splitlines())
+        out["kinds"] = _kinds(wn, out["forms"])
+        out["placing"] = _placing(wn)
+        out["body"] = _body(wn, (wordnet / "noun.exc").read_text().splitlines())
         out["forms"] = dict(sorted(out["forms"].items()))
         return out
 
@@ -313,6 +327,61 @@ def _growth(wn: Any, forms: dict[str, str]) -> dict[str, str]:
                                 if adj.name().isalpha() and adj.name() == adj.name().lower():
                                     out.setdefault(adj.name(), word)
     return dict(sorted(out.items()))
+
+
+def _kinds(wn: Any, forms: dict[str, str]) -> dict[str, list[str]]:
+    """Words for a kind of several categories ("appliance", "plumbing fixture") -> those
+    categories: the lemmas of every artifact synset above the roots of two categories or more,
+    but of at most two thirds of them (above that: "artifact", "instrumentality"), whose word's
+    first noun sense is an artifact ("area" is a region first, "vessel" a blood vessel), whose
+    first artifact sense above categories is this one, and which is used as a noun at least as
+    often as otherwise in WordNet's sense-tagged corpus ("good" is an adjective first). A word
+    that already names a category ("seat": a chair) keeps it."""
+    cats_under: dict[str, set[str]] = {}
+    for cat, roots in ROOTS.items():
+        for n in roots:
+            for path in wn.synset(n.rstrip("!")).hypernym_paths():
+                for a in path:
+                    cats_under.setdefault(a.name(), set()).add(cat)
+
+    def used(lemma: str, pos: str) -> int:
+        return sum(lem.count() for s in wn.synsets(lemma, pos) for lem in s.lemmas() if lem.name() == lemma)
+
+    out: dict[str, list[str]] = {}
+    for name, cats in sorted(cats_under.items()):
+        s = wn.synset(name)
+        if s.lexname() != "noun.artifact" or not 2 <= len(cats) <= 2 * len(ROOTS) // 3:
+            continue
+        for lem in s.lemmas():
+            lemma, form = lem.name(), _form(lem.name())
+            if lemma != lemma.lower() or form in forms or form in ROOM_WORDS:
+                continue
+            senses = [k for k in wn.synsets(lemma, "n") if any(x.name() == lemma for x in k.lemmas())]
+            kinds = [k for k in senses if k.lexname() == "noun.artifact" and k.name() in cats_under]
+            if not kinds or kinds[0].name() != name or senses[0].lexname() != "noun.artifact":
+                continue  # "area": a region first; "vessel": a blood vessel first
+            if used(lemma, "n") < max(used(lemma, pos) for pos in ("v", "a", "s", "r")):
+                continue
+            out[form] = sorted(cats)
+    return dict(sorted(out.items()))
+
+
+#: Verb senses of putting a thing down on a support (their own lemmas): "put into a certain
+#: place", "put in a horizontal position", "put something in a resting position, as for
+#: support", "place temporarily"; and, with their hyponyms (plonk, plunk, plump down), "put or
+#: settle into a position" and "cause to ... be in a settled position or place". Not the
+#: hyponyms of the first ones: they bury, sow, bottle and install.
+PLACING_SENSES = ["put.v.01", "lay.v.02", "rest.v.08", "park.v.01"]
+PLACING_TREES = ["set_down.v.03", "set_down.v.04"]
+
+
+def _placing(wn: Any) -> list[str]:
+    """Verbs (and phrasal verbs) of putting something down (``PLACING_SENSES``, ``PLACING_TREES``)."""
+    out = {_form(lem.name()) for n in PLACING_SENSES for lem in wn.synset(n).lemmas()}
+    for n in PLACING_TREES:
+        for s in [wn.synset(n), *wn.synset(n).closure(lambda x: x.hyponyms())]:
+            out |= {_form(lem.name()) for lem in s.lemmas()}
+    return sorted(f for f in out if f.replace(" ", "").isalpha() and f == f.lower())
 
 
 def _is_name(wn: Any, lemma: str) -> bool:
@@ -498,12 +567,24 @@ def _persons(wn: Any, exceptions: list[str]) -> list[str]:
     in lower case in the sense-tagged corpus, with their plurals (regular ones and WordNet's
     exceptions, ``noun.exc``: children, men): "where can the kids sit" asks where people sit, not
     where things are kept."""
+    return _nouns_of(wn, "noun.person", exceptions)
+
+
+def _body(wn: Any, exceptions: list[str]) -> list[str]:
+    """Nouns whose most frequent sense is a part of the body (noun.body), with their plurals
+    (feet): "somewhere to rest my feet" rests the person, not a thing put down."""
+    return _nouns_of(wn, "noun.body", exceptions)
+
+
+def _nouns_of(wn: Any, lexname: str, exceptions: list[str]) -> list[str]:
+    """Lower-case nouns seen in the sense-tagged corpus whose first sense is in ``lexname``, with
+    their plurals."""
     out: set[str] = set()
     for lemma in wn.all_lemma_names("n"):
         if lemma != lemma.lower() or not lemma.isalpha():
             continue
         senses = [x for x in wn.synsets(lemma, "n") if any(lem.name() == lemma for lem in x.lemmas())]
-        if senses and senses[0].lexname() == "noun.person" and _seen(wn, lemma):
+        if senses and senses[0].lexname() == lexname and _seen(wn, lemma):
             out.add(lemma)
     plural = {w + ("es" if w.endswith(("s", "x", "ch", "sh")) else "s") for w in out if not w.endswith("y")}
     plural |= {w[:-1] + "ies" for w in out if w.endswith("y") and w[-2:-1] not in "aeiou"}

@@ -76,7 +76,8 @@ def test_a_negation_on_the_verb_is_kept():
 @pytest.mark.parametrize(("text", "room", "origin", "side"), [
     ("stepping out of the kitchen into the hall, the plant on your left", "hallway", "kitchen", "left"),
     ("the plant on the right as you walk from the kitchen into the lounge", "living room", "kitchen", "right"),
-    ("once you come through the hallway into the office go to the desk", "office", None, None),
+    # a room walked through just before the one entered is where the way in starts
+    ("once you come through the hallway into the office go to the desk", "office", "hallway", None),
 ])
 def test_the_room_comes_from_the_targets_clause(text, room, origin, side):
     q = parse_instruction(text)

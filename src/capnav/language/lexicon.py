@@ -46,6 +46,13 @@ class Lexicon:
     labels: dict[str, str] = field(default_factory=dict)
     #: nouns that name a person, with plurals ("kids", "guests": noun.person in WordNet)
     persons: frozenset[str] = frozenset()
+    #: a word for a kind of several categories -> those categories ("appliance": refrigerator,
+    #: stove, washing machine; WordNet's hypernyms, see build_lexicon)
+    kinds: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    #: verbs of putting a thing down on a support ("put", "set down", "rest", "plonk")
+    placing: frozenset[str] = frozenset()
+    #: nouns for parts of the body, with plurals ("feet": noun.body in WordNet)
+    body: frozenset[str] = frozenset()
     load_seconds: float = 0.0
 
     def category_alternatives(self, category: str, form: str | None = None) -> dict[str, float]:
@@ -80,7 +87,9 @@ def load_lexicon() -> Lexicon:
                   foreign=frozenset(raw.get("foreign", [])), english=frozenset(raw.get("english", [])),
                   not_typos=frozenset(raw.get("not_typos", [])), sizes=dict(raw.get("sizes", {})),
                   growth=dict(raw.get("growth", {})), labels=dict(raw.get("labels", {})),
-                  persons=frozenset(raw.get("persons", [])))
+                  persons=frozenset(raw.get("persons", [])),
+                  kinds={k: tuple(v) for k, v in raw.get("kinds", {}).items()},
+                  placing=frozenset(raw.get("placing", [])), body=frozenset(raw.get("body", [])))
     object.__setattr__(lex, "load_seconds", time.perf_counter() - t0)
     return lex
 

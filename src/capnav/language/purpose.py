@@ -122,9 +122,48 @@ def find_activity(text: str) -> str | None:
         if m:
             act = _TAIL.sub("", m.group("act")).strip(" ,?.!")
             act = re.sub(r"^(?:please|just|quickly)\s+", "", act)
+            act = re.sub(r"\s+(?:right|just|somewhere|anywhere)$", "", act)  # "... right next to the bed"
             if act and act not in _PLACEHOLDERS:
                 return act
     return None
+
+
+#: Words after a placing verb that put the thing away or inside it: storage, not a surface
+#: ("put my jumpers away", "put the milk in").
+_AWAY = {"away", "in", "into", "inside", "up", "back", "under", "within"}
+
+
+def _verb_forms(word: str) -> list[str]:
+    """``word`` and the base forms it may be inflected from ("putting" -> put, "resting" -> rest,
+    "placing" -> place, "sets" -> set)."""
+    out = [word]
+    if word.endswith("ing") and len(word) > 4:
+        stem = word[:-3]
+        out += [stem, stem + "e"] + ([stem[:-1]] if len(stem) > 2 and stem[-1] == stem[-2] else [])
+    elif word.endswith("s") and len(word) > 3:
+        out.append(word[:-1])
+    return out
+
+
+def is_placing(activity: str) -> bool:
+    """Whether the activity puts a thing down on a support ("rest my cup", "set down a book",
+    "plonk my keys"): its verb is one of the lexicon's placing verbs (WordNet's), the thing is no
+    part of the speaker's body ("rest my feet" rests the person), and nothing puts it away."""
+    words = normalise_activity(activity).split()
+    if not words:
+        return False
+    lex = load_lexicon()
+    if not any(v in lex.placing or f"{v} {words[1] if len(words) > 1 else ''}".strip() in lex.placing
+               for v in _verb_forms(words[0])):
+        return False
+    return not any(w in _AWAY or w in lex.body for w in words[1:])
+
+
+def surfaces(lexicon: Lexicon | None = None) -> list[str]:
+    """The categories a thing is put down on: the table and its kinds in the lexicon (WordNet's
+    table: "a piece of furniture having a smooth flat top")."""
+    lex = lexicon or load_lexicon()
+    return ["table", *sorted(c for c, rel in lex.relations.get("table", {}).items() if rel.get("kind_of"))]
 
 
 #: ``CapNavMap.caches`` key of the stored gloss embeddings.
@@ -280,6 +319,14 @@ def purpose_categories(match: PurposeMatch, config: PurposeConfig | None = None)
     score, weighted by their score relative to the best."""
     cfg = config or PurposeConfig()
     items = list(match.scores.items())
+    if is_placing(match.activity):
+        # Any surface serves a thing put down: the scores only order them ("my laptop": a desk).
+        keep = set(surfaces())
+        items = [(c, v) for c, v in items if c in keep]
+        if not items:
+            return None, {}
+        top = max(items[0][1], 1e-6)
+        return items[0][0], {c: round(min(0.95, 0.95 * max(v, 0.0) / top), 3) or 0.05 for c, v in items[1:]}
     if not items or items[0][1] < cfg.min_score:
         return None, {}
     best_cat, best = items[0]
@@ -291,5 +338,6 @@ def purpose_categories(match: PurposeMatch, config: PurposeConfig | None = None)
     return best_cat, alts
 
 
-__all__ = ["CACHE_KEY", "GlossIndex", "PurposeConfig", "PurposeMatch", "find_activity", "gloss_index",
-           "match_purpose", "normalise_activity", "purpose_categories", "stated_purpose", "use_stored_glosses"]
+__all__ = ["CACHE_KEY", "GlossIndex", "PurposeConfig", "PurposeMatch", "find_activity", "gloss_index", "is_placing",
+           "match_purpose", "normalise_activity", "purpose_categories", "stated_purpose", "surfaces",
+           "use_stored_glosses"]

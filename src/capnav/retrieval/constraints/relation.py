@@ -110,6 +110,12 @@ class Relation(RankingConstraint):
             st.group_keys.append(-centre if far else centre)
             st.predicate = f"{q.proximity} to the {q.anchor_category}"
         else:
-            st.group_keys.append(np.round(gap / BIN_M))  # quarter-metre bins, attributes break ties
+            key = np.round(gap / BIN_M)  # quarter-metre bins, attributes break ties
+            if q.purpose is not None:
+                # "somewhere by the bed to put my glass": every category named serves the purpose,
+                # so the landmark chooses among them before their order of fit (after a room).
+                st.group_keys.insert(1 if q.room is not None else 0, key)
+            else:
+                st.group_keys.append(key)
             st.predicate = q.relation
         st.mode = "predicate"

@@ -46,7 +46,12 @@ class Room(RankingConstraint):
         q, r, pool = st.q, st.r, st.pool
         rooms = [r.scene.rooms[i] for i in pool]
         in_room = np.array([x == room for x in rooms], dtype=np.float64)
-        unknown = np.array([x is None for x in rooms], dtype=np.float64)
+        # A candidate where no room was inferred is unobserved, unless the map has the named room
+        # elsewhere: a region typed kitchen says where the kitchen is, so a stool in an untyped
+        # region (a hallway) is evidence against "the kitchen stool".
+        elsewhere = any(x == room for x, _ in r.scene.region_rooms.values())
+        unknown = np.array([x is None and not (elsewhere and int(r.scene.region[i]) >= 0)
+                            for x, i in zip(rooms, pool, strict=True)], dtype=np.float64)
         strength = r.scene.room_score[pool, _ROOMS.index(room)]
         for k, i in enumerate(pool):
             status = SUPPORTED if in_room[k] else UNOBSERVED if unknown[k] else CONTRADICTED

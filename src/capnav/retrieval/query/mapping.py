@@ -134,6 +134,57 @@ def _purpose_context(q: ParsedQuery, head: str) -> str:
     return head[: m.start()].strip()
 
 
+_REL_ALT = "|".join(re.escape(r) for r in sorted(_RELATIONS, key=len, reverse=True))
+#: A landmark between the place word and its purpose: "somewhere right by the bed to put my glass",
+#: "anywhere near the sofa where I can set down a book".
+_PLACE_LANDMARK = re.compile(
+    r"\b(?:somewhere|someplace|anywhere|(?:a|some)\s+(?:place|spot|surface|space)|something|anything)"
+    r"(?P<mid>\s+(?:right\s+|just\s+)?(?P<rel>" + _REL_ALT + r")\s+" + _ARTICLE + r"(?P<lm>.+?))"
+    r"\s+(?=(?:to|where|for|on\s+which|that)\b)")
+
+
+def _place_landmark(q: ParsedQuery, head: str) -> str:
+    """"somewhere right by the bed to put my glass": the landmark said between the place word and
+    the purpose is where the place is, not what is asked for. Returns ``head`` without it."""
+    m = _PLACE_LANDMARK.search(head)
+    if m is None:
+        return head
+    found = _landmark(m.group("lm").split())
+    if found is None or found[2]:
+        return head
+    rel = m.group("rel")
+    q.relation = "next to" if rel in ("besides", "beside", "by", "close to", "alongside") else rel
+    q.anchor_category, q.anchor_phrase = found[0], found[1]
+    return (head[: m.start("mid")] + head[m.end("mid"):]).strip()
+
+
+#: A landmark named by what is done there: "next to where I sleep", "by the spot where we eat".
+_ACTIVITY_PLACE = re.compile(
+    r"\b(?P<rel>" + "|".join(re.escape(r) for r in sorted(_RELATIONS, key=len, reverse=True)) + r")\s+"
+    r"(?:(?:the|a)\s+(?:place|spot|area|bit)\s+)?where\s+(?P<who>(?:i|we|you|one|they|he|she)|(?:the|my|our|your|his"
+    r"|her|their)\s+\w+)\s+(?:usually\s+|normally\s+|always\s+)?(?P<act>(?!(?:is|are|was|were)\b)\w+(?:\s+\w+){0,5}?)"
+    r"(?=\s*(?:[,;]|$|\b(?:in|and|but|so|please)\b))")
+
+
+def _activity_landmark(q: ParsedQuery, head: str, embedder: TextEmbedder | None) -> str:
+    """"where can I leave my phone next to where I sleep": the landmark is named by the activity
+    done at it, resolved like a request by purpose (the furniture made for sleeping); the target
+    is what the rest of the sentence asks for. Returns ``head`` without the landmark phrase."""
+    if embedder is None or "where" not in head:
+        return head
+    m = _ACTIVITY_PLACE.search(head)
+    if m is None or m.start() == 0:
+        return head
+    best, _ = purpose_categories(match_purpose(m.group("act"), embedder))
+    if best is None:
+        return head
+    rel = m.group("rel")
+    q.relation = "next to" if rel in ("besides", "beside", "by", "close to", "alongside") else rel
+    q.anchor_category, q.anchor_phrase = best, best
+    q.notes.append(f"'where {m.group('who')} {m.group('act')}' is read as the {best} (what serves it)")
+    return (head[: m.start()] + " " + head[m.end():]).strip()
+
+
 def _between(q: ParsedQuery, head: str) -> str:
     """"the lamp between the black bed and the white wardrobe": two landmarks, each with its
     own words. Returns ``head`` without them."""
@@ -278,6 +329,11 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     head = _negations(q, norm)
     # "somewhere to rest my plate while we watch the tv": the tv is where, not what.
     head = _purpose_context(q, head)
+    # "somewhere right by the bed to put my glass": the landmark of the place asked for.
+    head = _place_landmark(q, head)
+    # "somewhere to leave my phone next to where I sleep": a landmark named by its use.
+    if q.anchor_category is None:
+        head = _activity_landmark(q, head, embedder)
     # "the lamp in the room with the green wardrobe", "the dresser in the bedroom with the grey bed".
     head = _room_with(q, head)
     # An ordinal and where it counts from: "the second stool from the fridge", "number two from
@@ -370,6 +426,9 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     if cat is not None and span is not None:
         form = " ".join(words[span[0]:span[1]])
         q.category_alternatives = _LEX.category_alternatives(cat, None if fuzzy else form)
+        if cat in _LEX.kinds:
+            # "the appliance on your left": every category of the kind is the named one.
+            q.category, q.category_alternatives = None, dict.fromkeys(_LEX.kinds[cat], 1.0)
         if q.room is None:
             room, start = _room_before(words, span[0])
             if room is not None:
@@ -377,7 +436,9 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                 words = words[:start] + words[span[0]:]
                 span = (start, start + span[1] - span[0])
     rest = [w for k, w in enumerate(words) if (span is None or not span[0] <= k < span[1]) and w not in known]
-    if cat is None:
+    if cat is not None and q.category is None:  # a kind of several categories
+        q.unknown_words = rest
+    elif cat is None:
         q.unknown_words = rest
         activity = find_activity(head) if other is None else None
         if activity is not None:
@@ -399,7 +460,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     if q.category is None and q.purpose is None and any(w in _GENERIC for w in words):
         q.generic, q.unknown_words = True, []
     desc = list(dict.fromkeys(w for part in (*q.colors, *q.materials, *q.shapes) for w in part.split()))
-    noun = q.category if q.category is not None else " ".join(rest[-2:]) if rest else ""
+    noun = q.category if q.category is not None else cat if cat is not None else " ".join(rest[-2:]) if rest else ""
     q.target_phrase = " ".join([*desc, noun]).strip() or norm
     return q
 

@@ -372,7 +372,7 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
         if t.text.lower() in _GENERIC and t.pos_ in ("NOUN", "PRON") and not any(s <= t.i < e for _, s, e, _ in cands):
             cands.append(((int(_is_landmark(t)), _depth(t), 1, t.i), t.i, t.i + 1, None))
     for t in doc:
-        if t.text.lower() in _SIDES and t.pos_ != "VERB":
+        if _is_side(t):
             g.side = _SIDES[t.text.lower()]
     for s, e, room in rooms:
         gov = _governor(_span_head(doc, s, e))
@@ -381,6 +381,13 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
         g.rooms.append((role, room))
         if role == "origin" and g.origin_room is None:
             g.origin_room = room
+    if g.origin_room is None:
+        # "through the kitchen and into the lounge": the way into the room entered starts in the
+        # room walked through just before it.
+        for (r1, a), (r2, b) in zip(g.rooms, g.rooms[1:], strict=False):
+            if r1 == "passed" and r2 == "target" and a != b:
+                g.origin_room = a
+                break
     if not cands:
         g.notes.append("the parse found no object the vocabulary names; read by word patterns and similarity")
         return g
@@ -420,14 +427,18 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
             continue  # "from the door to the landing": the mapping reads the door phrase whole (count.py)
         if gov in _ROOM_ORIGIN or gov in _ROOM_PASSED:
             prep = rh.head if rh.dep_ == "pobj" else rh
-            drop = {t.i for t in prep.subtree}
+            drop = {t.i for t in prep.subtree} - _clauses_below(rh)
             if prep.text.lower() == "of" and prep.head.text.lower() == "out":
                 drop |= {prep.head.i}
-            keep -= drop
+            # The room's phrase only: a clause the parser hung on the room noun ("from the hall,
+            # which desk do you reach first") or the target's own words are not the way in.
+            keep -= drop - on_path - {t.i for t in head.subtree}
     # "to your left", "on the right-hand side": a side, not an attribute.
     for t in doc:
-        if t.text.lower() in _SIDES and t.pos_ != "VERB":
+        if _is_side(t):
             keep -= {j for i in _side_phrase(t) for j in _word_of(doc, doc[i])}
+        elif t.text.lower() in _SIDES:
+            keep -= {t.i}  # "right next to the bed": an intensifier, no side and no attribute
     # An attribute word the parse does not attach to the head, to a landmark or to a stand-in for
     # the target ("the white one") is not the target's: "when I am green with envy".
     own = {t.i for t in head.subtree}
@@ -445,6 +456,25 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
                 and any(m[0] <= t.i < m[1] for m in mentions):
             g.landmarks.append((t.head.text.lower(), doc[t.left_edge.i:t.i + 1].text))
     return g
+
+
+#: Dependencies that start a clause of their own under a noun: not part of that noun's phrase.
+_CLAUSE_DEPS = {"relcl", "acl", "advcl", "ccomp", "conj", "cc", "appos", "parataxis"}
+
+
+def _clauses_below(t: Token) -> set[int]:
+    """The tokens of the clauses hanging on the noun ``t`` (a relative clause, a conjoined one)."""
+    return {k.i for c in t.children if c.dep_ in _CLAUSE_DEPS for k in c.subtree}
+
+
+def _is_side(t: Token) -> bool:
+    """Whether ``t`` says a side ("on your left", "the right-hand one"): not a verb, and not the
+    adverb that intensifies a preposition ("right next to", "right by the door")."""
+    if t.text.lower() not in _SIDES or t.pos_ == "VERB":
+        return False
+    nxt = t.doc[t.i + 1] if t.i + 1 < len(t.doc) else None
+    return not (t.dep_ == "advmod" and (t.head.pos_ in ("ADP", "ADV") or (nxt is not None and nxt.pos_ == "ADP"
+                                                                           and nxt.head.i == t.head.i)))
 
 
 def _side_phrase(t: Token) -> set[int]:

@@ -55,6 +55,11 @@ for _cat in CATEGORIES:
     for _f in (_cat.name, *_cat.synonyms):
         _FORM_MAP[_f] = _cat.name
         _FORM_MAP.setdefault(_plural(_f), _cat.name)
+#: Words for a kind of several categories ("appliance", "furniture") name themselves here; the
+#: mapping asks for every category of the kind (``Lexicon.kinds``).
+for _f in _LEX.kinds:
+    _FORM_MAP.setdefault(_f, _f)
+    _FORM_MAP.setdefault(_plural(_f), _f)
 #: The detector's classes that are not categories, by their everyday names (WordNet's, the
 #: lexicon's ``labels``): "the mug on the table" asks for a cup, not the table.
 LABEL_MAP: dict[str, str] = {}
@@ -189,9 +194,22 @@ def _find_category(words: list[str]) -> tuple[str | None, tuple[int, int] | None
     """(category, word span, fuzzy) of the first object mention: a category (exact n-grams before
     typos), or a detector class named before it ("the mug on the table": a cup)."""
     cat, span, fuzzy = _find_vocabulary(words)
+    while span is not None and not fuzzy and (nxt := _exact_at(words, span[1])) is not None:
+        # A noun compound's head is its last noun: "the desk chair" is a chair, "the tv cabinet"
+        # a cabinet; the category word before it says what kind.
+        cat, span = nxt
     # A class's exact name also beats a typo read at the same place ("hair drier" is no "chair").
     label = _find_label(words, len(words) if span is None else span[0] + int(fuzzy))
     return label if label is not None else (cat, span, fuzzy)
+
+
+def _exact_at(words: list[str], i: int) -> tuple[str, tuple[int, int]] | None:
+    """The category whose exact name starts at word ``i`` (longest first), else None."""
+    for n in (3, 2, 1):
+        gram = " ".join(words[i:i + n])
+        if i + n <= len(words) and gram in _FORM_MAP:
+            return _FORM_MAP[gram], (i, i + n)
+    return None
 
 
 def _find_label(words: list[str], before: int) -> tuple[str, tuple[int, int], bool] | None:
