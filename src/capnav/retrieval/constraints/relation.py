@@ -9,6 +9,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.core.errors import InputError
+from capnav.language.purpose import is_placing
 from capnav.retrieval.constraints.base import RankingConstraint, RankState, ranking
 from capnav.retrieval.query import BETWEEN, END_OF, ROOM_WITH, ParsedQuery, parse_instruction
 from capnav.retrieval.spatial import end_distance, has_long_axis, segment_distance
@@ -111,9 +112,11 @@ class Relation(RankingConstraint):
             st.predicate = f"{q.proximity} to the {q.anchor_category}"
         else:
             key = np.round(gap / BIN_M)  # quarter-metre bins, attributes break ties
-            if q.purpose is not None:
-                # "somewhere by the bed to put my glass": every category named serves the purpose,
+            if q.purpose is not None and is_placing(q.purpose):
+                # "somewhere by the bed to put my glass": every surface serves a thing put down,
                 # so the landmark chooses among them before their order of fit (after a room).
+                # Other purposes keep their order of fit first: their runners-up may merely allow
+                # the activity, and standing near the landmark does not make them serve it.
                 st.group_keys.insert(1 if q.room is not None else 0, key)
             else:
                 st.group_keys.append(key)
