@@ -11,7 +11,6 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from capnav.core.geodesic import grid_geodesic
 from capnav.core.grid import FREE, OCCUPIED, UNKNOWN, GridSpec, OccupancyGrid
 
 
@@ -80,6 +79,8 @@ def geodesic_from_boxes(domain: NDArray[np.bool_], spec: GridSpec, los: NDArray[
     seeds = box_seeds(domain, spec, los, his)
     if len(seeds) == 0:
         return np.full(domain.shape, np.inf)
+    from capnav.core.geodesic import grid_geodesic  # numba only when a distance is asked for
+
     return grid_geodesic(domain, seeds, limit_m / spec.resolution) * spec.resolution
 
 
@@ -105,6 +106,8 @@ def segment_rooms(domain: NDArray[np.bool_], spec: GridSpec, door_width: float =
     goes to the core it is walked to first (one geodesic per core), so a doorway, a corridor too
     narrow for a core and the space under furniture belong to the room they open into."""
     from scipy import ndimage
+
+    from capnav.core.geodesic import grid_geodesic  # numba only when rooms are segmented
 
     r = int(np.ceil(0.5 * door_width / spec.resolution))
     yy, xx = np.mgrid[-r:r + 1, -r:r + 1]

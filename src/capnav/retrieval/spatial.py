@@ -15,7 +15,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.core.errors import InputError
-from capnav.core.geodesic import walk_base, walk_box_minima
 from capnav.core.grid import OCCUPIED, OccupancyGrid
 from capnav.language.rooms import box_cells, box_seeds, fill_gaps
 
@@ -97,6 +96,9 @@ class FloorDistances:
             (r0, c0), (r1, c1) = self.spec.to_cell(lo), self.spec.to_cell(hi)
             dom[max(r0, 0):max(r1 + 1, 0), max(c0, 0):max(c1 + 1, 0)] = True
         self.domain = dom
+        # numba (0.5 s of CPU to import) only when a walking distance is asked for, not per query.
+        from capnav.core.geodesic import walk_base
+
         self._base = walk_base(dom)  # the padded start of every search, copied per source
         # Each object's cells and its cells grown by RING, once per map (read by every search).
         self._boxes = np.array([box_cells(self.spec, lo, hi) for lo, hi in zip(self.los, self.his, strict=True)],
@@ -116,6 +118,8 @@ class FloorDistances:
             if len(seeds) == 0:
                 hit = np.full(len(self._boxes), np.inf)
             else:
+                from capnav.core.geodesic import walk_box_minima
+
                 hit = walk_box_minima(self._base, self.spec.cols, seeds, self._boxes, self._grown,
                                       self.spec.resolution, RING)
             while self._cache and len(self._cache) >= self._size:
