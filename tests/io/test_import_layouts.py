@@ -5,6 +5,7 @@ poses with the frames in source order; each layout's bad input is refused with i
 from __future__ import annotations
 
 import json
+import re
 import shutil
 from pathlib import Path
 
@@ -219,3 +220,23 @@ def test_a_wrong_convention_is_refused_with_the_reason(tmp_path: Path, walk: lis
     assert res.exit_code != 0 and isinstance(res.exception, InputError)
     msg = str(res.exception)
     assert "do not fit together as read" in msg and says in msg and "as recorded" in msg, msg
+
+
+@pytest.mark.parametrize(("present", "layout", "missing"), [
+    (("image/", "depth/"), "open3d", "trajectory.log"),
+    (("color/", "depth/", "pose/"), "scannet", "intrinsic/"),
+    (("rgb.txt",), "tum", "depth.txt"),
+    (("odometry.csv", "depth/"), "stray", "camera_matrix.csv"),
+])
+def test_auto_names_the_missing_part_of_the_nearest_layout(tmp_path: Path, present: tuple[str, ...],
+                                                           layout: str, missing: str) -> None:
+    """A folder holding most of one layout is told which of that layout's files it lacks, not the list
+    of every layout (a recording copied without its trajectory is the usual case)."""
+    src = tmp_path / "rec"
+    src.mkdir()
+    for p in present:
+        (src / p.rstrip("/")).mkdir() if p.endswith("/") else (src / p).write_text("# x\n")
+    want = rf"looks like a {layout} recording \(has .*\) but {re.escape(missing)} is missing"
+    with pytest.raises(InputError, match=want) as e:
+        detect(src)
+    assert "Looked for" not in str(e.value)

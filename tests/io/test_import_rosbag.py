@@ -258,3 +258,18 @@ def test_corrupt_bag_is_named(tmp_path: Path) -> None:
     (tmp_path / "x.bag").write_bytes(b"#ROSBAG V2.0\n garbage")
     with pytest.raises(InputError, match=r"cannot open bag .*x.bag"):
         RosbagReader(tmp_path / "x.bag", "/a", "/b", "/c", "/d")
+
+
+def test_damaged_ros2_metadata_says_how_to_rebuild_it(tmp_path: Path, frames: list[Frame]) -> None:
+    """A ROS2 bag whose metadata.yaml was cut short (a copy interrupted) or edited by hand: one line
+    naming the file and ``ros2 bag reindex``, not the YAML parser's multi-line message."""
+    bag = tmp_path / "run2"
+    write_bag(bag, frames[:2], ros2=True)
+    meta = bag / "metadata.yaml"
+    text = meta.read_text()
+    for broken in (text[: len(text) // 3], "topics: []\n"):
+        meta.write_text(broken)
+        with pytest.raises(InputError, match=r"its metadata.yaml is damaged or incomplete .*ros2 bag reindex") as e:
+            RosbagReader(bag, "/camera/color/image_raw/compressed", "/camera/depth/image_raw",
+                         "/camera/color/camera_info", "/camera/pose")
+        assert "\n" not in str(e.value)

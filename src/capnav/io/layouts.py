@@ -1,7 +1,9 @@
 """Which recording layout a folder (or file) is, from the files it holds, and the reader for it.
 
 ``capnav import auto SRC`` asks ``detect``; each layout names the files that gave it away, so the
-user reads what was recognised. A folder matching no layout gets the list of what was looked for.
+user reads what was recognised. A folder holding at least half of one layout's parts (a recording
+copied without its trajectory) is told which of them it lacks; any other folder gets the list of
+what was looked for.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from capnav.core.errors import CapNavError, InputError
+from capnav.io.open3d_log import COLOUR_DIRS
 
 if TYPE_CHECKING:
     from capnav.io.importer import Recording
@@ -25,6 +28,26 @@ class Layout:
     looks_like: str
     evidence: Callable[[Path], str | None]
     reader: Callable[..., Recording] | None  # keyword options: intrinsics, depth_scale
+    #: The files and folders (``name/``) a folder of this layout holds, each with its alternatives;
+    #: what ``detect`` compares a folder with when no layout matches whole.
+    parts: tuple[tuple[str, ...], ...] = ()
+
+    def missing(self, root: Path) -> tuple[list[str], list[str]]:
+        """The parts ``root`` has (the name found) and the ones it lacks (the first alternative)."""
+        has: list[str] = []
+        lacks: list[str] = []
+        for alts in self.parts:
+            found = next((a for a in alts if _exists(root, a)), None)
+            (has.append(found) if found is not None else lacks.append(alts[0]))
+        return has, lacks
+
+
+def _exists(root: Path, name: str) -> bool:
+    if name.endswith("/"):
+        return (root / name.rstrip("/")).is_dir()
+    if name.startswith("*"):
+        return any(root.glob(name))
+    return (root / name).is_file()
 
 
 def _has(root: Path, *names: str) -> bool:
@@ -97,14 +120,16 @@ def _open(module: str, cls: str) -> Callable[..., Recording]:
 
 LAYOUTS: tuple[Layout, ...] = (
     Layout("capnav-rgbd", "meta.json with format capnav-rgbd (already a CapNav dataset)", _capnav, None),
-    Layout("tum", "rgb.txt, depth.txt, groundtruth.txt", _tum, _open("capnav.io.tum", "TumReader")),
+    Layout("tum", "rgb.txt, depth.txt, groundtruth.txt", _tum, _open("capnav.io.tum", "TumReader"),
+           (("rgb.txt",), ("depth.txt",))),
     Layout("rosbag", "a ROS1 .bag file or a ROS2 bag folder", _rosbag, None),
     Layout("scannet", "color/, depth/, pose/, intrinsic/ (ScanNet's exported frames)", _scannet,
-           _open("capnav.io.scannet", "ScannetReader")),
+           _open("capnav.io.scannet", "ScannetReader"), (("color/",), ("depth/",), ("pose/",), ("intrinsic/",))),
     Layout("open3d", "image/ (or color/), depth/, trajectory.log (Open3D / Redwood)", _open3d,
-           _open("capnav.io.open3d_log", "Open3dReader")),
+           _open("capnav.io.open3d_log", "Open3dReader"),
+           (tuple(f"{d}/" for d in COLOUR_DIRS), ("depth/",), ("trajectory.log", "*.log"))),
     Layout("stray", "odometry.csv, camera_matrix.csv, depth/, rgb.mp4 or rgb/ (Stray Scanner)", _stray,
-           _open("capnav.io.stray", "StrayReader")),
+           _open("capnav.io.stray", "StrayReader"), (("odometry.csv",), ("camera_matrix.csv",), ("depth/",))),
     Layout("3dmatch", "frame-XXXXXX.color.png|jpg, .depth.png, .pose.txt, camera-intrinsics.txt", _3dmatch,
            _open("capnav.io.threedmatch", "ThreeDMatchReader")),
 )
@@ -118,8 +143,27 @@ def detect(src: Path) -> tuple[Layout, str]:
         ev = lay.evidence(src) if src.is_dir() or lay.name == "rosbag" else None
         if ev is not None:
             return lay, ev
+    near = _nearest(src) if src.is_dir() else None
+    if near is not None:
+        lay, has, lacks = near
+        raise InputError(f"{src} looks like a {lay.name} recording (has {', '.join(has)}) but "
+                         f"{' and '.join(lacks)} {'is' if len(lacks) == 1 else 'are'} missing "
+                         f"(a {lay.name} folder holds {lay.looks_like})")
     known = "; ".join(f"{lay.name}: {lay.looks_like}" for lay in LAYOUTS)
     raise InputError(f"{src}: not a recording layout CapNav knows. Looked for {known}")
+
+
+def _nearest(root: Path) -> tuple[Layout, list[str], list[str]] | None:
+    """The layout of which ``root`` holds the largest share of parts, when that is at least half."""
+    best: tuple[float, int, Layout, list[str], list[str]] | None = None
+    for lay in LAYOUTS:
+        if not lay.parts:
+            continue
+        has, lacks = lay.missing(root)
+        share = len(has) / len(lay.parts)
+        if share >= 0.5 and lacks and (best is None or (share, len(has)) > best[:2]):
+            best = (share, len(has), lay, has, lacks)
+    return None if best is None else best[2:]
 
 
 def open_recording(src: Path, **opts: Any) -> tuple[Recording, Layout, str]:

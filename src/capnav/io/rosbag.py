@@ -242,7 +242,11 @@ class RosbagReader:
             reader = highlevel.AnyReader([path], default_typestore=store)
             reader.open()
         except Exception as e:  # AnyReaderError, or the ROS1/ROS2 readers' own errors on a corrupt file
-            raise InputError(f"cannot open bag {self.path}: {type(e).__name__}: {e}") from None
+            why = " ".join(str(e).split())  # YAML errors span lines; the CLI shows one
+            if path.is_dir() and ("metadata" in why.lower() or "yaml" in why.lower()):
+                raise InputError(f"cannot open bag {self.path}: its metadata.yaml is damaged or incomplete ({why}); "
+                                 f"ROS2 rebuilds it from the bag's files with `ros2 bag reindex {path}`") from None
+            raise InputError(f"cannot open bag {self.path}: {type(e).__name__}: {why}") from None
         try:
             yield reader
         except Exception as e:
