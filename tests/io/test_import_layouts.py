@@ -236,7 +236,7 @@ def test_auto_names_the_missing_part_of_the_nearest_layout(tmp_path: Path, prese
     src.mkdir()
     for p in present:
         (src / p.rstrip("/")).mkdir() if p.endswith("/") else (src / p).write_text("# x\n")
-    want = rf"looks like a {layout} recording \(has .*\) but {re.escape(missing)} is missing"
+    want = rf"looks like the {layout} layout \(has .*\) but {re.escape(missing)} is missing"
     with pytest.raises(InputError, match=want) as e:
         detect(src)
     assert "Looked for" not in str(e.value)

@@ -146,9 +146,9 @@ def detect(src: Path) -> tuple[Layout, str]:
     near = _nearest(src) if src.is_dir() else None
     if near is not None:
         lay, has, lacks = near
-        raise InputError(f"{src} looks like a {lay.name} recording (has {', '.join(has)}) but "
+        raise InputError(f"{src} looks like the {lay.name} layout (has {', '.join(has)}) but "
                          f"{' and '.join(lacks)} {'is' if len(lacks) == 1 else 'are'} missing "
-                         f"(a {lay.name} folder holds {lay.looks_like})")
+                         f"(the {lay.name} layout holds {lay.looks_like})")
     known = "; ".join(f"{lay.name}: {lay.looks_like}" for lay in LAYOUTS)
     raise InputError(f"{src}: not a recording layout CapNav knows. Looked for {known}")
 
