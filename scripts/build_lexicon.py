@@ -30,8 +30,11 @@ is spoken to):
   plant kingdom (and its lemmas include olive, orange, rose), so only houseplants, pot plants,
   succulents (cactus, aloe), ferns, palms and bonsai are taken. WordNet 3.0 has no nightstand
   (bedside table): its nearest synset, ``stand.n.04`` (a small table for holding articles), gives
-  the nightstand's gloss. The counter is ``counter.n.01`` without its hyponyms (shop counters,
-  bars, checkouts) plus the countertop. The toilet includes the British
+  the nightstand's gloss. A category's first synset is what it is (its kinds and its Wu-Palmer
+  similarities come from it): the bookshelf is ``bookcase.n.01`` first, the piece of furniture that
+  CapNav's bookshelf is, and ``bookshelf.n.01`` (a single shelf, a support) gives its name. The
+  counter is ``counter.n.01`` without its hyponyms (shop counters, bars, checkouts) plus the
+  countertop. The toilet includes the British
   ``water_closet.n.01`` (loo) although WordNet files it as a room, and so is every room WordNet
   defines only by the fixture it is equipped with (``toilet.n.01``, "a room or building equipped
   with one or more toilets": lavatory, lav, privy). Lamps are ``lamp.n.02`` (the
@@ -129,7 +132,7 @@ ROOTS: dict[str, list[str]] = {
     "wardrobe": ["wardrobe.n.01"],
     "dresser": ["chest_of_drawers.n.01"],
     "cabinet": ["cabinet.n.01", "buffet.n.01", "cupboard.n.01"],
-    "bookshelf": ["bookshelf.n.01", "bookcase.n.01"],
+    "bookshelf": ["bookcase.n.01", "bookshelf.n.01"],
     "tv": ["television_receiver.n.01"],
     "lamp": ["lamp.n.02"],
     "plant": ["houseplant.n.01", "pot_plant.n.01", "succulent.n.01", "fern.n.01", "palm.n.03", "bonsai.n.01"],
@@ -336,13 +339,16 @@ def _kinds(wn: Any, forms: dict[str, str]) -> dict[str, list[str]]:
     first noun sense is an artifact ("area" is a region first, "vessel" a blood vessel), whose
     first artifact sense above categories is this one, and which is used as a noun at least as
     often as otherwise in WordNet's sense-tagged corpus ("good" is an adjective first). A word
-    that already names a category ("seat": a chair) keeps it."""
+    that already names a category ("seat": a chair) keeps it. Only the ancestors of a category's
+    own sense (its first root) count: its other roots bring its other names, and what lies above
+    those only is not what the category is (the loo is filed as a room, the cupboard as a storage
+    space, the writing desk as a box, so "structure" and "container" would cover a toilet, a
+    cabinet and a desk)."""
     cats_under: dict[str, set[str]] = {}
     for cat, roots in ROOTS.items():
-        for n in roots:
-            for path in wn.synset(n.rstrip("!")).hypernym_paths():
-                for a in path:
-                    cats_under.setdefault(a.name(), set()).add(cat)
+        for path in wn.synset(roots[0].rstrip("!")).hypernym_paths():
+            for a in path:
+                cats_under.setdefault(a.name(), set()).add(cat)
 
     def used(lemma: str, pos: str) -> int:
         return sum(lem.count() for s in wn.synsets(lemma, pos) for lem in s.lemmas() if lem.name() == lemma)

@@ -96,3 +96,41 @@ def test_cactus_words_imply_the_columnar_growth_form():
         assert w not in lex.growth, w
     # a glossary entry is no definition: WordNet's example sentences are not kept as glosses
     assert not any(g.startswith("he sat") for g in lex.glosses["bed"])
+
+
+def _wordnet_and_script():
+    if not (WORDNET / "data.noun").exists() or importlib.util.find_spec("nltk") is None:
+        pytest.skip("WordNet 3.0 (/usr/share/wordnet) or nltk is not installed")
+    import tempfile
+
+    spec = importlib.util.spec_from_file_location("build_lexicon", REPO / "scripts" / "build_lexicon.py")
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod.open_wordnet(WORDNET, Path(tempfile.mkdtemp())), mod
+
+
+def test_a_kind_word_lies_above_the_category_s_own_sense():
+    # The extra synsets of a category bring its other names (a loo is filed as a room, a cupboard
+    # as a storage space, a writing desk as a box); what lies above them only is not what the
+    # category is, so it is no kind of it.
+    wn, mod = _wordnet_and_script()
+    lex = load_lexicon()
+    assert lex.kinds, "the lexicon has kind words"
+    for word, cats in lex.kinds.items():
+        senses = {s.name() for s in wn.synsets(word.replace(" ", "_"), "n")}
+        for cat in cats:
+            own = wn.synset(mod.ROOTS[cat][0].rstrip("!"))
+            above = {a.name() for path in own.hypernym_paths() for a in path}
+            assert senses & above, (word, cat)
+
+
+def test_kind_words_too_broad_for_a_category_are_not_kinds():
+    lex = load_lexicon()
+    # "container" reached the desk through a portable writing box and the sink through a basin;
+    # "structure" the cabinet through a cupboard as storage space and the toilet through the loo.
+    for w in ("container", "structure"):
+        assert w not in lex.kinds, (w, lex.kinds.get(w))
+    assert set(lex.kinds["appliance"]) == {"refrigerator", "stove", "washing machine"}
+    assert set(lex.kinds["plumbing fixture"]) == {"sink", "toilet"}
+    assert {"bed", "sofa", "wardrobe"} <= set(lex.kinds["furniture"])
