@@ -160,3 +160,28 @@ def test_footprint_ignores_stray_points() -> None:
     (obj,) = mem.export()
     assert obj.footprint[:, 0].max() <= obj.extent_max[0] + 1e-9 < 0.45
     assert obj.footprint[:, 1].max() > 0.95  # the real extent is kept
+
+
+def test_recheck_never_births_an_object_from_one_detection() -> None:
+    """A confirmed track whose detection no longer fits its object, and fits no other, starts its
+    confirmation again: a new object needs h_min detections of its own, as every object does (one
+    stray box on a chair's leg seen from a new side must not become a second chair)."""
+    from capnav.mapping import ObjectMemory, Observation, Track
+
+    rng = np.random.default_rng(1)
+    chair = rng.uniform(0, 0.45, (300, 3))
+    elsewhere = chair + np.array([0.0, 0.8, 0.0])
+    mem = ObjectMemory()
+    a = _feed(mem, 1, chair, range(0, 3))
+    t = Track(1, chair.mean(0), np.zeros(3), np.zeros(4), np.array([1.0, 0.0], np.float32), 3, "chair",
+              hits=4, object_id=a)
+    mem.objects[a].track_ids = [1]
+    obs = Observation(9, (0, 0, 10, 10), 100, 0.9, "chair", 2.0, False, 1.0)
+    assert mem.observe(t, _det(elsewhere), obs, 9, h_min=3, busy=set()) is None
+    assert sorted(mem.objects) == [a] and t.object_id is None and mem.relinks == 1
+    t.hits = 5
+    assert mem.observe(t, _det(elsewhere), obs, 10, h_min=3, busy=set()) is None
+    t.hits = 6
+    b = mem.observe(t, _det(elsewhere), obs, 11, h_min=3, busy=set())  # the third: a thing of its own
+    assert b is not None and b != a and sorted(mem.objects[b].frames) == [9, 10, 11]
+    assert 9 not in mem.objects[a].frames

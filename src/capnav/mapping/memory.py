@@ -105,6 +105,7 @@ class ObjectMemory:
         self.config = config or MemoryConfig()
         self.objects: dict[int, _ObjectState] = {}
         self._pending: dict[int, list[tuple[LiftedDetection, Observation, int]]] = {}
+        self._restarted: dict[int, int] = {}  # track id -> its hits before a recheck restarted it
         self._next_id = 1
         self.relinks = 0  # detections moved to another object by the recheck
         self._rng = np.random.default_rng(self.config.seed)
@@ -119,10 +120,11 @@ class ObjectMemory:
         if track.object_id is None:
             buf = self._pending.setdefault(track.id, [])
             buf.append((det, obs, frame))
-            if track.hits < h_min:
+            if track.hits - self._restarted.get(track.id, 0) < h_min:
                 return None
             oid = self._link(track, buf, busy)
             track.object_id = oid
+            self._restarted.pop(track.id, None)
             for d, o, f in self._pending.pop(track.id):
                 self._add(self.objects[oid], d, o, f)
             return oid
@@ -130,8 +132,16 @@ class ObjectMemory:
         if self.config.recheck and self._inconsistent(det.points, obj.points):
             self.relinks += 1
             obj.track_ids.remove(track.id)
-            track.object_id = self._link(track, [(det, obs, frame)], busy | {obj.id})
-            obj = self.objects[track.object_id]
+            other = self._match(track, [(det, obs, frame)], busy | {obj.id})
+            if other is None:
+                # Nothing known is there: confirmed afresh, like any track's first detections.
+                track.object_id = None
+                self._pending[track.id] = [(det, obs, frame)]
+                self._restarted[track.id] = track.hits - 1
+                return None
+            self.objects[other].track_ids.append(track.id)
+            track.object_id = other
+            obj = self.objects[other]
         self._add(obj, det, obs, frame)
         return track.object_id
 
@@ -149,8 +159,23 @@ class ObjectMemory:
     def drop(self, track: Track) -> None:
         """A track died: unconfirmed detections are forgotten (false positives), objects stay."""
         self._pending.pop(track.id, None)
+        self._restarted.pop(track.id, None)
 
     def _link(self, track: Track, buf: list[tuple[LiftedDetection, Observation, int]], busy: set[int]) -> int:
+        """The object ``buf``'s detections belong to: the best overlapping compatible one, else a new one."""
+        best = self._match(track, buf, busy)
+        if best is not None:
+            self.objects[best].track_ids.append(track.id)
+            return best
+        oid = self._next_id
+        self._next_id += 1
+        self.objects[oid] = _ObjectState(id=oid, points=np.zeros((0, 3), np.float32),
+                                         colors=np.zeros((0, 3), np.uint8),
+                                         feature=np.zeros_like(track.feature), track_ids=[track.id])
+        return oid
+
+    def _match(self, track: Track, buf: list[tuple[LiftedDetection, Observation, int]], busy: set[int]
+               ) -> int | None:
         pts = np.concatenate([d.points for d, _, _ in buf]) if buf else np.zeros((0, 3), np.float32)
         feat = np.mean([d.descriptor for d, _, _ in buf], axis=0) if buf else track.feature
         best, best_score = None, 0.0
@@ -162,15 +187,7 @@ class ObjectMemory:
             score = self._overlap(pts, obj.points)
             if score > best_score:
                 best, best_score = obj.id, score
-        if best is not None:
-            self.objects[best].track_ids.append(track.id)
-            return best
-        oid = self._next_id
-        self._next_id += 1
-        self.objects[oid] = _ObjectState(id=oid, points=np.zeros((0, 3), np.float32),
-                                         colors=np.zeros((0, 3), np.uint8),
-                                         feature=np.zeros_like(track.feature), track_ids=[track.id])
-        return oid
+        return best
 
     def _compatible(self, label: str, feat: NDArray[np.floating], obj: _ObjectState) -> bool:
         if labels_compatible(label, obj.label) or label in obj.votes:
