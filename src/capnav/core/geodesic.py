@@ -24,10 +24,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-_DR = np.array([-1, -1, -1, 0, 0, 1, 1, 1], dtype=np.int64)
-_DC = np.array([-1, 0, 1, -1, 1, -1, 0, 1], dtype=np.int64)
-_STEP = np.array([1.4142135623730951, 1.0, 1.4142135623730951, 1.0, 1.0, 1.4142135623730951, 1.0,
-                  1.4142135623730951])
+_SQRT2 = 1.4142135623730951
 #: The padded distance of a cell no walk enters (below every distance, so never "improved").
 BLOCKED = -1.0
 
@@ -52,43 +49,63 @@ def _walk(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int64], limit:
     """Cells from the nearest seed, on a copy of ``base`` (padded, ``cols`` + 2 wide)."""
     w = cols + 2
     dist = base.copy()
-    off = np.empty(8, np.int64)
-    for m in range(8):
-        off[m] = _DR[m] * w + _DC[m]
     # Three buckets suffice: a cell expanded from bucket k lands in k + 1 or k + 2 (steps < 2); a
-    # bucket holds a cell at most once.
-    buckets = np.empty((3, base.shape[0] + seeds.shape[0] + 1), np.int32)
-    fill = np.zeros(3, np.int64)
+    # bucket holds a cell at most once. They rotate (the one done becomes k + 3's), so a push
+    # picks its bucket by one comparison, with no modulo.
+    n = base.shape[0] + seeds.shape[0] + 1
+    cur = np.empty(n, np.int32)
+    nx1 = np.empty(n, np.int32)
+    nx2 = np.empty(n, np.int32)
+    fc = 0
     for i in range(seeds.shape[0]):
         u = (seeds[i, 0] + 1) * w + seeds[i, 1] + 1
         if dist[u] != 0.0:  # a seed starts the walk even where the domain is not walkable
             dist[u] = 0.0
-            buckets[0, fill[0]] = u
-            fill[0] += 1
+            cur[fc] = u
+            fc += 1
+    f1 = 0
+    f2 = 0
     k = 0
-    pending = fill[0]
-    while pending > 0:
-        b = k % 3
-        j = 0
-        while j < fill[b]:
-            u = buckets[b, j]
-            j += 1
+    while fc + f1 + f2 > 0:
+        k1 = k + 1
+        kf = float(k)
+        for j in range(fc):
+            u = cur[j]
             du = dist[u]
-            if int(du) != k or du > limit:  # stale (expanded from an earlier bucket), or too far
+            # Stale (expanded from an earlier bucket: below k, since it entered this one at >= k),
+            # or too far.
+            if du < kf or du > limit:
                 continue
             for m in range(8):
-                v = u + off[m]
-                nd = du + _STEP[m]
+                if m == 0:
+                    v, nd = u - w - 1, du + _SQRT2
+                elif m == 1:
+                    v, nd = u - w, du + 1.0
+                elif m == 2:
+                    v, nd = u - w + 1, du + _SQRT2
+                elif m == 3:
+                    v, nd = u - 1, du + 1.0
+                elif m == 4:
+                    v, nd = u + 1, du + 1.0
+                elif m == 5:
+                    v, nd = u + w - 1, du + _SQRT2
+                elif m == 6:
+                    v, nd = u + w, du + 1.0
+                else:
+                    v, nd = u + w + 1, du + _SQRT2
                 dv = dist[v]
                 if nd < dv:
-                    if dv == np.inf or int(dv) != int(nd):  # not in nd's bucket yet
-                        bv = int(nd) % 3
-                        buckets[bv, fill[bv]] = v
-                        fill[bv] += 1
-                        pending += 1
+                    b = int(nd)
+                    if dv == np.inf or int(dv) != b:  # not in nd's bucket yet
+                        if b == k1:
+                            nx1[f1] = v
+                            f1 += 1
+                        else:
+                            nx2[f2] = v
+                            f2 += 1
                     dist[v] = nd
-        pending -= fill[b]
-        fill[b] = 0
+        cur, nx1, nx2 = nx1, nx2, cur
+        fc, f1, f2 = f1, f2, 0
         k += 1
     return dist
 

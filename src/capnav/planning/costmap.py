@@ -99,6 +99,7 @@ def mark_blocked(costmap: Costmap, xy: NDArray[np.floating], radius: float, conf
     newly = (d <= reach) & np.isfinite(win) & ~keep
     win[newly] = np.inf
     costmap.cache.pop("goal_around", None)  # goal selection's per-object windows read the cells marked here
+    costmap.cache.pop("goal_pose", None)  # and the poses it chose on the weights before the mark
     return int(newly.sum())
 
 

@@ -20,7 +20,7 @@ relaxed one condition at a time and the reason says which one failed.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -154,12 +154,16 @@ def _around(cm: Costmap, fp: NDArray[np.float64], cfg: PlannerConfig, cols: Heig
     return _Around(lo, hi, dist, seen, in_room, region, sight)
 
 
+def _around_key(fp: NDArray[np.float64], cfg: PlannerConfig, z_range: tuple[float, float] | None) -> Any:
+    return (fp.shape, fp.tobytes(), cfg, None if z_range is None else (float(z_range[0]), float(z_range[1])))
+
+
 def _around_cached(cm: Costmap, fp: NDArray[np.float64], cfg: PlannerConfig, cols: HeightColumns | None,
                    z_range: tuple[float, float] | None) -> _Around:
     """``_around`` kept per costmap for the most recently asked objects: a fleet asks for the same
     objects again and again, from wherever its robots stand."""
     kept: dict[Any, _Around] = cm.cache.setdefault("goal_around", {})
-    key = (fp.shape, fp.tobytes(), cfg, None if z_range is None else (float(z_range[0]), float(z_range[1])))
+    key = _around_key(fp, cfg, z_range)
     hit = kept.pop(key, None)
     if hit is None:
         hit = _around(cm, fp, cfg, cols, z_range, None)
@@ -167,6 +171,12 @@ def _around_cached(cm: Costmap, fp: NDArray[np.float64], cfg: PlannerConfig, col
             kept.pop(next(iter(kept)), None)  # the least recently asked
     kept[key] = hit
     return hit
+
+
+#: Goal poses a costmap keeps per (object, start cell): the most recently chosen. A robot that
+#: asks again from where it stands (a second question, a retry, the plan after the answer), or a
+#: fleet's robots parked at the same dock, get the pose without a search; about 1 kB each.
+POSE_CACHE = 4096
 
 
 def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], start_xy: Any,
@@ -188,15 +198,31 @@ def select_goal(occ: OccupancyGrid, target_footprint: NDArray[np.floating], star
     fp = check_footprint(target_footprint)
     cm = costmap if costmap is not None else build_costmap(occ, cfg, columns)
     cols = columns if columns is not None else cm.columns
-    spec = cm.spec
     s_cell, _ = locate_start(cm, start_xy, cfg)
     if allowed is not None and np.shape(allowed) != cm.weights.shape:
         raise InputError(f"allowed goal cells must have the grid's shape {cm.weights.shape}, got {np.shape(allowed)}")
-    may = np.ones(cm.weights.shape, dtype=bool) if allowed is None else np.asarray(allowed, dtype=bool)
-    if allowed is None and cols is cm.columns:
-        ar = _around_cached(cm, fp, cfg, cols, z_range)
-    else:
-        ar = _around(cm, fp, cfg, cols, z_range, may)
+    if allowed is not None or cols is not cm.columns:
+        may = np.ones(cm.weights.shape, dtype=bool) if allowed is None else np.asarray(allowed, dtype=bool)
+        return _select(cm, fp, s_cell, cfg, _around(cm, fp, cfg, cols, z_range, may), may)
+    # The pose depends on the object, the start cell and the weights only: kept per costmap
+    # (dropped with the setup when a contact marks it, ``mark_blocked``).
+    kept: dict[Any, GoalPose] = cm.cache.setdefault("goal_pose", {})
+    key = (_around_key(fp, cfg, z_range), s_cell)
+    hit = kept.pop(key, None)
+    if hit is None:
+        hit = _select(cm, fp, s_cell, cfg, _around_cached(cm, fp, cfg, cols, z_range), None)
+        while len(kept) >= POSE_CACHE:
+            kept.pop(next(iter(kept)), None)  # the least recently chosen
+    kept[key] = hit
+    return replace(hit, xy=hit.xy.copy())
+
+
+def _select(cm: Costmap, fp: NDArray[np.float64], s_cell: tuple[int, int], cfg: PlannerConfig, ar: _Around,
+            allowed: NDArray[np.bool_] | None) -> GoalPose:
+    """``select_goal`` from the start cell ``s_cell`` with the object's setup ``ar`` (``allowed``:
+    None when every cell may be a goal)."""
+    spec = cm.spec
+    may = np.ones(cm.weights.shape, dtype=bool) if allowed is None else allowed
     lo, hi, dist, win = ar.lo, ar.hi, ar.dist, ar.win
     free = ar.seen & np.isfinite(cm.weights[win].ravel())
     within = free & (dist <= cfg.reach)

@@ -10,8 +10,10 @@ until one candidate is accepted, or "not found". Every step leaves a reason in w
 
 from __future__ import annotations
 
+import copy
 import re
 import time
+from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import replace
 
@@ -30,13 +32,15 @@ from capnav.mapping.objects import MapObject
 from capnav.retrieval import constraints
 from capnav.retrieval import time as time_scope
 from capnav.retrieval.config import RetrievalConfig
-from capnav.retrieval.query import ParsedQuery, parse_instruction
+from capnav.retrieval.query import ParsedQuery, parse_goals, parse_instruction
 from capnav.retrieval.ranking import Ranking, cosine_scores
 from capnav.retrieval.result import QueryResult
 from capnav.retrieval.spatial import FloorDistances
 from capnav.retrieval.verifier import AcceptFirst, Assessment, Candidate, OfflineVerifier, Verifier, a
 
 _VOCAB = set(NAMES)
+#: Instructions whose reading a retriever keeps (``Retriever.read_goals``).
+READINGS = 1024
 
 
 def check_map_embeddings(objects: Sequence[MapObject], embedder: TextEmbedder) -> None:
@@ -80,6 +84,7 @@ class Retriever:
         self.grid = occ.spec if occ is not None else self._grid_from_objects()
         self.cells = self.grid.to_cell(np.array([o.position[:2] for o in self.objects]))
         self._floor: FloorDistances | None = None  # walking distances, built on the first "closest"
+        self._readings: OrderedDict[str, list[ParsedQuery]] = OrderedDict()
         # An object's category: the caption's name when it is a vocabulary word, else its label.
         self.cats = []
         for o in self.objects:
@@ -135,6 +140,18 @@ class Retriever:
             his = np.array([o.extent_max[:2] for o in self.objects], dtype=np.float64)
             self._floor = FloorDistances(occ, los, his)
         return self._floor
+
+    def read_goals(self, instruction: str) -> list[ParsedQuery]:
+        """``query.parse_goals`` with this retriever's embedder, kept for the ``READINGS`` most
+        recently read instructions (a reading depends on the words and the embedder only; a server
+        hears the same requests again): each call gets its own copy to change."""
+        hit = self._readings.pop(instruction, None)
+        if hit is None:
+            hit = parse_goals(instruction, self.embedder)
+            while len(self._readings) >= READINGS:
+                self._readings.popitem(last=False)
+        self._readings[instruction] = hit
+        return copy.deepcopy(hit)
 
     def of_category(self, cat: str) -> NDArray[np.intp]:
         """Indices of the objects of category ``cat``."""

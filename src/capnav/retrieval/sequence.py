@@ -8,8 +8,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from capnav.retrieval.query import parse_goals
-
 if TYPE_CHECKING:
     from capnav.retrieval.result import QueryResult
     from capnav.retrieval.retriever import Retriever
@@ -42,7 +40,7 @@ class GoalSequence:
 
 def query_goals(retriever: Retriever, instruction: str, robot_xy: tuple[float, float] | None = None) -> GoalSequence:
     """Retrieve every goal of ``instruction`` in order; a goal not found stops the sequence."""
-    queries = parse_goals(instruction, retriever.embedder)
+    queries = retriever.read_goals(instruction)
     seq = GoalSequence(instruction, [q.text for q in queries])
     xy = robot_xy
     for k, q in enumerate(queries):

@@ -23,6 +23,11 @@ from capnav.language.rooms import box_cells, box_seeds, fill_gaps
 MIN_ELONGATION = 1.25
 #: An object whose own cells no walk reaches is measured at the ring of cells around it (m).
 RING = 0.3
+#: Walks a ``FloorDistances`` keeps by default (per source cell; an entry holds one float per
+#: object, not the field): at most this many sources and this many bytes. A robot that asks again
+#: from where it stands, or the goal sequence after it, then pays no walk.
+CACHE_SOURCES = 1024
+CACHE_BYTES = 8 << 20
 
 
 def segment_distance(p: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
@@ -84,10 +89,11 @@ class FloorDistances:
     """Walking distances (m) on a map's top-down grid from a point, or from landmark objects, to
     every object: one Dijkstra per source, shared by all candidates, through every cell not seen
     occupied and through the objects' own boxes (a sofa is walked around, but an object's cells
-    are where it is reached), never through walls. Results are cached per source cell."""
+    are where it is reached), never through walls. Results are cached per source cell
+    (``cache_size`` sources, default ``CACHE_SOURCES`` within ``CACHE_BYTES``; 0: none)."""
 
     def __init__(self, occ: OccupancyGrid, los: NDArray[np.float64], his: NDArray[np.float64],
-                 cache_size: int = 8) -> None:
+                 cache_size: int | None = None) -> None:
         self.spec = occ.spec
         self.los = np.asarray(los, dtype=np.float64).reshape(-1, 2)
         self.his = np.asarray(his, dtype=np.float64).reshape(-1, 2)
@@ -105,6 +111,8 @@ class FloorDistances:
                                dtype=np.int64).reshape(-1, 4)
         self._grown = np.array([box_cells(self.spec, lo - RING, hi + RING)
                                 for lo, hi in zip(self.los, self.his, strict=True)], dtype=np.int64).reshape(-1, 4)
+        if cache_size is None:  # an entry is one float per object: keep CACHE_BYTES of them
+            cache_size = int(min(CACHE_SOURCES, max(8, CACHE_BYTES // (8 * max(len(self._boxes), 1)))))
         if cache_size < 0:
             raise InputError(f"FloorDistances cache_size must be >= 0 (0: no cache), got {cache_size}")
         self._cache: dict[tuple[int, ...], NDArray[np.float64]] = {}
