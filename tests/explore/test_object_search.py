@@ -2,7 +2,9 @@
 room A. An object in room B (a room the map never saw) is searched for and reached; a chair the
 map has in room A but that was carried into room B is not at its place, so the robot searches and
 finds it there (not the red chair that stayed); an object that is nowhere ends the search with
-"not found within budget"."""
+"not found within budget". The request is answered by the retriever of ``capnav query`` on the map
+plus what the robot has seen: the first plant seen is not "the plant next to the lamp" before a
+lamp is seen, nor "the biggest plant" when a bigger one is in view."""
 
 from __future__ import annotations
 
@@ -18,9 +20,11 @@ from _synth_scene import ROOM, Box, HashEmbedder, render
 
 from capnav.core.frame import Frame
 from capnav.core.geometry import Intrinsics, look_at_pose
-from capnav.explore.search import Goal, ObjectSearch, SearchConfig
+from capnav.explore.search import ObjectSearch, SearchConfig
+from capnav.language import create_captioner, create_embedder, describe_map
 from capnav.mapping import CapNavMap, build_map
 from capnav.perception import create_detector, create_encoder
+from capnav.retrieval.retriever import Retriever
 
 SOFA, CHAIR, TABLE, LAMP, PLANT = 1, 3, 5, 15, 16
 BLUE, RED = (30, 40, 200), (200, 30, 30)
@@ -89,48 +93,63 @@ def first_map() -> CapNavMap:
         for j, eye in enumerate(((-1.2, 0.0), (-1.8, 0.4))):
             T = look_at_pose(np.array([*eye, 1.2]), float(yaw), math.radians(25))
             frames.append(render(boxes, T, K, index=2 * i + j))
-    cmap = build_map(frames, detector=create_detector("sim", noise="oracle", seed=0),
-                     encoder=create_encoder("label-embedding", embedder=HashEmbedder()), progress=False)
+    cmap = _captioned(build_map(frames, detector=create_detector("sim", noise="oracle", seed=0),
+                                encoder=create_encoder("label-embedding", embedder=HashEmbedder()), progress=False))
     labels = sorted(o.label for o in cmap.objects)
     assert "lamp" not in labels and labels.count("chair") == 2, labels
     return cmap
 
 
-def _search(cmap: CapNavMap, world: list[Box], goal: Goal, chosen: object = None, budget: float = 40.0):  # type: ignore[no-untyped-def]
+_EMB: list[object] = []
+
+
+def _captioned(cmap: CapNavMap) -> CapNavMap:
+    if not _EMB:
+        _EMB.append(create_embedder("minilm"))
+    describe_map(cmap, None, create_captioner("offline"), _EMB[0], progress=False)  # type: ignore[arg-type]
+    return cmap
+
+
+def _search(cmap: CapNavMap, world: list[Box], instruction: str, budget: float = 40.0):  # type: ignore[no-untyped-def]
     agent = BoxAgent(world, -1.2, -0.8, 0.0)
-    s = ObjectSearch(cmap, agent, create_detector("sim", noise="oracle", seed=0), HashEmbedder(),
+    retriever = Retriever(cmap, _EMB[0])  # type: ignore[arg-type]
+    s = ObjectSearch(cmap, agent, create_detector("sim", noise="oracle", seed=0), retriever,
                      SearchConfig(budget_m=budget))
-    return agent, s.run(goal, chosen, "test")  # type: ignore[arg-type]
+    return agent, s.run(instruction)
+
+
+def _gap(agent: BoxAgent, box: Box) -> float:
+    """Distance from the robot to a box's footprint."""
+    gap = np.maximum(0.0, np.maximum(np.array(box.lo[:2]) - agent.pose[:2], np.array(agent.pose[:2]) - box.hi[:2]))
+    return float(np.hypot(*gap))
 
 
 def test_object_in_a_room_the_map_never_saw_is_found(first_map: CapNavMap) -> None:
     world = _room_a((-0.3, 2.0))
-    agent, res = _search(first_map, world, Goal("lamp", "lamp"))
+    agent, res = _search(first_map, world, "the lamp")
     assert res.found, res.reason
     lamp = next(b for b in world if b.category == LAMP)
-    gap = np.maximum(0.0, np.maximum(np.array(lamp.lo[:2]) - agent.pose[:2], np.array(agent.pose[:2]) - lamp.hi[:2]))
-    assert float(np.hypot(*gap)) <= 1.0
-    assert res.steps[0].action == "look" and res.steps[1].action == "search" and "not in the map" in res.steps[1].reason
+    assert _gap(agent, lamp) <= 1.0
+    assert res.steps[0].action == "map" and "not in the map" in res.steps[0].reason
+    assert res.steps[1].action == "look"
     assert any("frontier" in s.reason for s in res.steps if s.action == "search")
     assert res.steps[-1].action == "found" and res.driven_m > 0
 
 
 def test_object_not_where_the_map_says_is_searched_and_found(first_map: CapNavMap) -> None:
     world = _room_a((1.9, 1.9))  # the blue chair was carried into room B
-    blue = max((o for o in first_map.objects if o.label == "chair"), key=lambda o: o.position[0])
-    agent, res = _search(first_map, world, Goal("chair", "blue chair", ("blue",)), blue)
+    agent, res = _search(first_map, world, "the blue chair")
     assert res.found and not res.from_map, res.reason
     assert math.dist(agent.pose[:2], (1.9, 1.9)) <= 1.3
     text = " | ".join(s.reason for s in res.steps)
-    assert "the map has it" in text and "not at its place" in text
+    assert "the map has it" in text and "asked again" in text
 
 
 def test_a_new_colour_where_a_known_object_stood_is_not_that_object(first_map: CapNavMap) -> None:
     """The red chair was thrown out and the blue one set down exactly there: a blue chair seen on
     the map's red chair is the blue one, not the red one the map holds."""
     world = [b for b in _room_a((-2.25, -0.05)) if b.color != RED]
-    blue = max((o for o in first_map.objects if o.label == "chair"), key=lambda o: o.position[0])
-    agent, res = _search(first_map, world, Goal("chair", "blue chair", ("blue",)), blue)
+    agent, res = _search(first_map, world, "the blue chair")
     assert res.found and not res.from_map, res.reason
     assert math.dist(agent.pose[:2], (-2.25, -0.05)) <= 1.3
 
@@ -139,10 +158,9 @@ def test_the_goal_beside_the_robot_is_seen_before_it_leaves(first_map: CapNavMap
     """The blue chair now stands beside the start, the map has it across the room: the robot looks
     around first and goes to the one it sees, not to the map's place."""
     world = _room_a((-0.2, -1.4))
-    blue = max((o for o in first_map.objects if o.label == "chair"), key=lambda o: o.position[0])
-    _, res = _search(first_map, world, Goal("chair", "blue chair", ("blue",)), blue)
+    _, res = _search(first_map, world, "the blue chair")
     assert res.found and res.driven_m <= 1.5, res.reason
-    assert [s.action for s in res.steps][:2] == ["look", "found"]
+    assert [s.action for s in res.steps][:2] == ["map", "look"] and "found" in [s.action for s in res.steps[:4]]
 
 
 def test_a_colour_of_a_part_is_searched_for(first_map: CapNavMap) -> None:
@@ -150,7 +168,7 @@ def test_a_colour_of_a_part_is_searched_for(first_map: CapNavMap) -> None:
     quarter to a third of it is the goal; a colour need not be the object's largest."""
     plant = [Box((1.75, 1.55, 0.0), (2.25, 2.05, 0.4), 9, PLANT, BLUE),  # the pot
              Box((1.75, 1.55, 0.4), (2.25, 2.05, 1.0), 9, PLANT, (40, 140, 50))]  # the leaves
-    agent, res = _search(first_map, [*_room_a((-0.3, 2.0)), *plant], Goal("plant", "plant", ("blue",)))
+    agent, res = _search(first_map, [*_room_a((-0.3, 2.0)), *plant], "the plant in the blue pot")
     assert res.found, res.reason
     assert math.dist(agent.pose[:2], (2.0, 1.8)) <= 1.3
 
@@ -164,18 +182,43 @@ def test_a_newcomer_in_the_colour_of_a_part_of_the_old_one_is_new(first_map: Cap
     frames = [render(mapped, look_at_pose(np.array([*eye, 1.2]), float(yaw), math.radians(25)), K, index=2 * i + j)
               for i, yaw in enumerate(np.radians(np.linspace(55, 305, 24)))
               for j, eye in enumerate(((-1.2, 0.0), (-1.8, 0.4)))]
-    cmap = build_map(frames, detector=create_detector("sim", noise="oracle", seed=0),
-                     encoder=create_encoder("label-embedding", embedder=HashEmbedder()), progress=False)
+    cmap = _captioned(build_map(frames, detector=create_detector("sim", noise="oracle", seed=0),
+                                encoder=create_encoder("label-embedding", embedder=HashEmbedder()), progress=False))
     black = Box((-2.5, -0.3, 0.0), (-2.0, 0.2, 0.9), 7, CHAIR, (25, 25, 28))
     world = [b for b in _room_a((-0.3, 2.0)) if b.color != RED] + [black]
-    agent, res = _search(cmap, world, Goal("chair", "black chair", ("black",)))
+    agent, res = _search(cmap, world, "the black chair")
     assert res.found, res.reason
     assert math.dist(agent.pose[:2], (-2.25, -0.05)) <= 1.3
 
 
+def test_the_first_plant_seen_is_not_the_one_next_to_the_lamp(first_map: CapNavMap) -> None:
+    """Two plants the map never saw: one in view through the door from the start, one beside the
+    lamp in the corner of room B that no first view shows. The first is not the answer before a
+    lamp has been seen; the search goes on until it sees the lamp and the plant beside it."""
+    near_door = Box((2.2, 0.2, 0.0), (2.6, 0.6, 0.8), 20, PLANT, (40, 140, 50))
+    by_lamp = Box((1.7, -2.6, 0.0), (2.1, -2.2, 0.8), 21, PLANT, (40, 140, 50))
+    world = [*_room_a((-0.3, 2.0)), near_door, by_lamp]
+    agent, res = _search(first_map, world, "the plant next to the lamp")
+    assert res.found, res.reason
+    assert _gap(agent, by_lamp) <= 1.0 and _gap(agent, by_lamp) < _gap(agent, near_door), (agent.pose, res.reason)
+    text = " | ".join(s.reason for s in res.steps)
+    assert "no lamp seen yet" in text, text
+
+
+def test_the_biggest_plant_is_compared_with_the_others_seen(first_map: CapNavMap) -> None:
+    """Two new plants in view from the start, a small one close by and a big one across the room:
+    "the biggest plant" is the big one, not the nearer first sighting of a plant."""
+    small = Box((0.0, -2.3, 0.0), (0.3, -2.0, 0.45), 20, PLANT, (40, 140, 50))
+    big = Box((-1.9, 0.3, 0.0), (-1.3, 0.9, 1.4), 21, PLANT, (40, 140, 50))
+    world = [*_room_a((-0.3, 2.0)), small, big]
+    agent, res = _search(first_map, world, "the biggest plant")
+    assert res.found, res.reason
+    assert _gap(agent, big) <= 1.0 and _gap(agent, big) < _gap(agent, small), (agent.pose, res.reason)
+
+
 def test_budget_running_out_says_so(first_map: CapNavMap) -> None:
     world = _room_a((-0.3, 2.0))
-    _, res = _search(first_map, world, Goal("bookshelf", "bookshelf"), budget=3.0)
+    _, res = _search(first_map, world, "the bookshelf", budget=3.0)
     assert not res.found
     assert res.reason.startswith("not found within budget: drove"), res.reason
     assert res.driven_m <= 3.0 + 0.25

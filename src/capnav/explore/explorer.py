@@ -93,6 +93,8 @@ class FrontierExplorer:
         self.frame: Frame | None = None
         self.looks = 0  # observations made (the costly part of an action)
         self.path_limit: float | None = None  # metres of agent odometry after which the budget is spent
+        #: Called with every frame looked at and its detections (a search maps them as it goes).
+        self.on_look: Callable[[Frame, list[Any]], None] | None = None
         self._looked_from: tuple[float, float, float] | None = None  # pose of the last observation
         agent_cfg = getattr(agent, "cfg", None) or getattr(agent, "config", None)
         self.turn = math.radians(float(getattr(agent_cfg, "turn_deg", 30.0)))
@@ -119,6 +121,8 @@ class FrontierExplorer:
         self.map.update(frame)
         self.map.mark_free_disk((x, y))
         dets = self.detector.detect(frame) if self.detector is not None else []
+        if self.on_look is not None:
+            self.on_look(frame, list(dets))
         self.new_sightings = lift(frame, dets, self.config.min_sighting_points,
                                   colours=self.config.sighting_colours)
         self.sightings.extend(self.new_sightings)

@@ -1,16 +1,18 @@
-"""Search for an object the map is silent or stale about: go where it would be, look, map, re-ask.
+"""Search for an object the map is silent or stale about: go where it would be, look, map, ask again.
 
-``capnav navigate MAP "..." --search`` in the simulator. The map is asked first; when it names an
-object, the robot drives there on an online map that starts from the saved map's occupancy and
-is corrected by its own depth (``OnlineMap`` with a prior), and looks around. The goal counts as
-seen only from the robot's own frames: a detection of the goal's category (in the goal's colour
-when the goal names one) that the map does not already explain as another object of that
-category. When the map names nothing (the object is new, or retired), or the object is not at
-its place, the robot searches: the map's room regions ranked by where such an object would be
-(``places``), and frontiers of space neither the map nor the robot has seen, each weighed by its
-prior over the path to it. At each place it looks around; every batch of views is asked again
-whether it shows the goal. The search ends when the goal is reached, or when the budget (metres
-driven, seconds) is spent. Every step's reason is kept, in order.
+``capnav navigate MAP "..." --search`` in the simulator. The request is answered as ``capnav
+query`` answers it, by the same retriever, but on a map that grows as the robot looks: the saved
+map's objects less those the robot's own depth saw gone, plus every object the robot saw that the
+saved map does not explain (``live_map``). After each batch of views the retriever is asked again
+with the instruction, so "the smallest cabinet" is compared with every cabinet seen so far and "the
+plant next to the washing machine" waits for a washing machine to be seen. The robot first looks
+around where it stands; then it goes where the answer is: a saved object's place (to see it there,
+else it is not there and the question is asked again without it), or, with no answer, the map's
+room regions ranked by where such an object would be (``places``) and frontiers of space neither
+the map nor the robot has seen, each weighed by its prior over the path to it. The search ends when
+the answer is an object the robot has seen (where the map did not explain it, or at its saved place)
+and the robot stands by it, or when the budget (metres driven, seconds) is spent. Every step's
+reason is kept, in order.
 
 Nothing here reads the simulator's truth: the agent is only driven and asked for frames.
 """
@@ -28,14 +30,15 @@ import numpy as np
 from capnav.core.errors import InputError
 from capnav.core.grid import FREE
 from capnav.explore.explorer import ExplorerConfig, FrontierExplorer, Status
+from capnav.explore.live_map import LiveMap, LiveMapConfig, Snapshot
 from capnav.explore.online_map import OnlineMap, OnlineMapConfig
 from capnav.explore.places import Place, PlaceConfig, room_places
-from capnav.explore.sighting import Sighting
-from capnav.explore.votes import outvoted
 from capnav.language.embedder import TextEmbedder
 from capnav.mapping.cmap import CapNavMap, MapObject
 from capnav.planning import PlannerConfig
 from capnav.planning.search import cost_field
+from capnav.retrieval.query import ParsedQuery, parse_goals
+from capnav.retrieval.result import QueryResult
 
 
 @dataclass(frozen=True)
@@ -45,20 +48,17 @@ class SearchConfig:
 
     budget_m: float = 60.0
     budget_s: float | None = None
-    goal_score: float = 0.55  # detector confidence a goal sighting needs
-    label_match: float = 0.6  # label-goal cosine when the goal names no known category
-    at_place: float = 1.0  # m: a goal sighting this close to the map object's box confirms it
-    known_margin: float = 0.4  # m: a sighting inside another same-label object's box plus this, in its colours, is it
-    colour_distance: float = 20.0  # CIEDE2000 (kL 2) within which a seen colour is the goal's colour word
-    stop_distance: float = 0.8  # m from the sighted goal's centre
-    cluster_radius: float = 1.0  # m: goal sightings this close refine the target
-    vote_radius: float = 0.5  # m: a goal sighting outvoted by other labels this close is a confusion
+    at_place: float = 1.0  # m: the robot looks for a saved object from this close to its place
+    stop_distance: float = 0.8  # m from the answer's footprint
+    cluster_radius: float = 1.0  # m: a seen object this close to the answer (of its label) refines where it is
+    batch_views: int = 4  # views between two questions to the retriever
     distance_scale: float = 4.0  # m: a place's prior is divided by 1 + path / this
     frontier_prior: float = 0.25  # prior of unseen space beyond a frontier of ``frontier_cells`` or more
     frontier_cells: int = 20  # a smaller frontier (a pocket behind furniture) has a prior in proportion
     seen_fraction: float = 0.6  # a region looked around in and this much seen by the robot's own depth is spent
     seen_anyway: float = 0.9  # a region this much seen is spent even if the robot never stood in it
     places: PlaceConfig = field(default_factory=PlaceConfig)
+    live: LiveMapConfig = field(default_factory=LiveMapConfig)
     planner: PlannerConfig = field(default_factory=PlannerConfig)
 
     def __post_init__(self) -> None:
@@ -66,13 +66,15 @@ class SearchConfig:
             raise InputError(f"search budget must be a positive number of metres, got {self.budget_m}")
         if self.budget_s is not None and not self.budget_s > 0:
             raise InputError(f"search time budget must be positive seconds, got {self.budget_s}")
+        if self.batch_views < 1:
+            raise InputError(f"batch_views must be >= 1, got {self.batch_views}")
 
 
 @dataclass
 class SearchStep:
     """One decision of the search: what it did, where, and why."""
 
-    action: str  # "map", "drive", "look", "search", "found", "not found"
+    action: str  # "map", "ask", "drive", "look", "search", "found", "not found"
     reason: str
     xy: tuple[float, float] | None = None
     driven_m: float = 0.0  # metres driven since the request when the step was taken
@@ -92,94 +94,114 @@ class SearchResult:
     looks: int
     from_map: bool  # the goal was where the map said
     chosen_object: int | None = None
+    asks: int = 0  # questions to the retriever on the growing map
 
     def to_dict(self) -> dict[str, Any]:
         return {"found": self.found, "reason": self.reason, "from_map": self.from_map, "looks": self.looks,
+                "asks": self.asks,
                 "driven_m": round(self.driven_m, 3), "chosen_object": self.chosen_object,
                 "target_xy": None if self.target_xy is None else [round(v, 3) for v in self.target_xy],
                 "steps": [s.to_dict() for s in self.steps]}
 
 
-@dataclass(frozen=True)
-class Goal:
-    """What the robot's camera must show: a category (or a phrase for labels) and colour words."""
+@dataclass
+class Answer:
+    """The retriever's answer on the map plus what the robot has seen, and what it is to the search:
+    ``new`` (an object the robot saw that the saved map does not explain), ``confirmed`` (a saved
+    object seen again at its place), ``saved`` (a saved object not yet looked for), ``open`` (an
+    object seen, but the request's landmark has not been: not yet an answer) or ``none``."""
 
-    category: str | None
-    phrase: str
-    colours: tuple[str, ...] = ()
+    kind: str
+    obj: MapObject | None
+    reason: str
+    seen: int = 0  # objects seen that the saved map does not explain, when asked
 
-    @property
-    def what(self) -> str:
-        kind = self.category or self.phrase
-        return f"{' '.join(self.colours)} {kind}".strip()
+    def same(self, other: Answer | None) -> bool:
+        if other is None or other.kind != self.kind:
+            return False
+        if self.obj is None or other.obj is None:
+            return self.obj is other.obj
+        if self.kind == "new":  # a seen object's id is renumbered as the map grows: its place names it
+            return self.obj.label == other.obj.label and \
+                float(np.hypot(*(self.obj.position[:2] - other.obj.position[:2]))) < 1.0
+        return self.obj.id == other.obj.id
 
 
 class ObjectSearch:
     """One request's search with a live agent (anything with ``pose``, ``step``, ``observe`` and
-    ``path_length``) and the shared detector."""
+    ``path_length``), the shared detector and the retriever of the saved map (``capnav query``'s)."""
 
-    def __init__(self, cmap: CapNavMap, agent: Any, detector: Any, embedder: TextEmbedder,
+    def __init__(self, cmap: CapNavMap, agent: Any, detector: Any, retriever: Any,
                  config: SearchConfig | None = None) -> None:
         if detector is None:
             raise InputError("a search needs a detector to see the goal with the robot's own camera")
-        self.cmap, self.agent, self.detector, self.embedder = cmap, agent, detector, embedder
+        self.cmap, self.agent, self.detector, self.retriever = cmap, agent, detector, retriever
+        self.embedder: TextEmbedder = retriever.embedder
         self.config = cfg = config or SearchConfig()
         spec = cmap.occupancy.spec
         centre = (spec.x0 + 0.5 * spec.cols * spec.resolution, spec.y0 + 0.5 * spec.rows * spec.resolution)
         half = 0.5 * max(spec.cols, spec.rows) * spec.resolution + 3.0
         online = OnlineMap(centre, OnlineMapConfig(resolution=spec.resolution, half_extent=half), cmap.occupancy)
         # A look every 30 degrees: a search must not miss the goal between two views.
-        self.explorer = FrontierExplorer(agent, detector, ExplorerConfig(planner=cfg.planner, sighting_colours=True,
-                                                                         keyframe_turn_deg=30.0), online)
+        self.explorer = FrontierExplorer(agent, detector, ExplorerConfig(planner=cfg.planner, keyframe_turn_deg=30.0),
+                                         online)
+        self.live = LiveMap(cmap, detector, self.embedder, cfg.live)
+        self.explorer.on_look = self.live.add
         self.steps: list[SearchStep] = []
         self._odo0 = float(getattr(agent, "path_length", 0.0))
         self._t0 = time.monotonic()
         self._timed_out = False
-        self._object_colours: dict[int, list[tuple[float, float, float]]] = {}
+        self._answer: Answer | None = None
+        self._asked_at = -1  # views when last asked
+        self._signature: tuple[Any, ...] | None = None
+        self.asks = 0
+        self._snap: Snapshot | None = None
+        self._found_id: int | None = None
 
     # ------------------------------------------------------------------ the request
-    def run(self, goal: Goal, chosen: MapObject | None, map_reason: str) -> SearchResult:
-        """Look around, go to ``chosen`` (the map's answer, None when it has none) and confirm it,
-        else search."""
+    def run(self, instruction: str | ParsedQuery, first: QueryResult | None = None) -> SearchResult:
+        """Answer ``instruction`` with the robot's own eyes: ask the saved map (``first``, when the
+        caller has asked it already), look around, and go where the answer is, asking again after
+        every batch of views, until the answer is an object the robot has seen, or the budget is
+        spent."""
         cfg, ex = self.config, self.explorer
         ex.begin(10**9)
         ex.path_limit = self._odo0 + cfg.budget_m
-        self._goal = goal
-        self._stale = chosen
+        self._instruction = instruction
+        self._parsed = instruction if isinstance(instruction, ParsedQuery) else \
+            parse_goals(instruction, self.embedder)[0]
+        self._start = ex.xy
+        q = first if first is not None else self.retriever.query(instruction, robot_xy=self._start)
+        self._first = q.chosen if q.found else None
+        if self._first is not None:
+            self._log("map", f"the map has it: object {self._first.id} ({self._first.caption or self._first.label}) "
+                             f"at ({self._first.position[0]:.2f}, {self._first.position[1]:.2f}); {q.reason}",
+                      _xy(self._first))
+        else:
+            self._log("map", f"not in the map: {q.reason}")
+        self._answer = Answer("saved" if self._first is not None else "none", self._first, q.reason)
         # Look before leaving: turning in place costs no distance, and the goal may stand right here.
         self._log("look", "looking around where the request was heard", ex.xy)
         ex.observe()
         if not self._stop(ex):
             ex.look_around(self._stop)
-        hits = self._hits(ex.sightings)
-        if hits:
-            return self._approach(hits, from_map=chosen is not None and any(self._at(s, chosen) for s in hits))
-        if chosen is not None:
-            cxy = (float(chosen.position[0]), float(chosen.position[1]))
-            self._log("map", f"the map has it: object {chosen.id} ({chosen.caption or chosen.label}) at "
-                             f"({cxy[0]:.2f}, {cxy[1]:.2f}); {map_reason}", cxy)
-            st = ex.approach(lambda: cxy, cfg.at_place + 0.2, self._stop)
-            if not self._over(st):
-                self._log("look", f"at the map's place of object {chosen.id}: looking around", ex.xy)
-                ex.look_around(self._stop)
-            hits = self._hits(ex.sightings)
-            if hits:
-                return self._approach(hits, from_map=any(self._at(s, chosen) for s in hits))
-            if self._over(None):
-                return self._out_of_budget()
-            self._log("search", f"not at its place: no {goal.what} seen within {cfg.at_place:.1f} m of where the map "
-                                f"has object {chosen.id} after {ex.looks} views; searching", ex.xy)
-        else:
-            self._log("search", f"not in the map ({map_reason}); searching", ex.xy)
-        return self._search()
+        return self._loop()
 
-    # ------------------------------------------------------------------ search loop
-    def _search(self) -> SearchResult:
+    def _loop(self) -> SearchResult:
         cfg, ex = self.config, self.explorer
-        places, regions = room_places(self.cmap, self._goal.category, self.embedder, cfg.places)
+        places, regions = room_places(self.cmap, self._parsed.category, self.embedder, cfg.places)
         visited: list[tuple[float, float]] = []
         self._looked_in: set[int] = {self._region_at(regions, ex.xy)}
         while not self._over(None):
+            ans = self._ask(force=True)
+            if ans.kind in ("new", "confirmed") and ans.obj is not None:
+                res = self._approach(ans)
+                if res is not None:
+                    return res
+                continue
+            if ans.kind == "saved" and ans.obj is not None:
+                self._check_place(ans.obj)
+                continue
             grid = ex.grid()
             cm = ex.costmap(grid)
             cands = [p for p in places if not self._spent(p, visited, regions)]
@@ -189,7 +211,7 @@ class ObjectSearch:
                       for f in fronts if all(math.dist(f.target_xy, v) > ex.config.visited_radius for v in visited)]
             if not cands:
                 return self._end(f"not found: every place worth looking was looked at ({len(visited)} places, "
-                                 f"{ex.looks} views) and no {self._goal.what} was seen")
+                                 f"{ex.looks} views) and {self._none_text(ans)}")
             dist = self._path_lengths(grid, cm, [p.xy for p in cands])
             utility = np.array([p.prior for p in cands]) / (1.0 + dist / cfg.distance_scale)
             utility[~np.isfinite(dist)] = -1.0
@@ -208,11 +230,82 @@ class ObjectSearch:
             elif not self._over(st) and st is not Status.STOPPED:
                 self._log("look", "looking around", ex.xy)
                 ex.look_around(self._stop)
-            hits = self._hits(ex.sightings)
-            if hits:
-                return self._approach(hits, from_map=False)
         return self._out_of_budget()
 
+    def _check_place(self, o: MapObject) -> None:
+        """Go to a saved object's place and look around; not seen there, it is not there."""
+        cfg, ex = self.config, self.explorer
+        cxy = _xy(o)
+        self._log("drive", f"to the map's place of object {o.id} ({o.caption or o.label}) at "
+                           f"({cxy[0]:.2f}, {cxy[1]:.2f}) to see it", cxy)
+        st = ex.approach(lambda: cxy, cfg.at_place + 0.2, self._stop)
+        if st is Status.STOPPED or self._over(st):
+            return
+        self._log("look", f"at the map's place of object {o.id}: looking around", ex.xy)
+        if ex.look_around(self._stop) is Status.STOPPED:
+            return
+        ans = self._ask(force=True)
+        if ans.kind == "confirmed" or (ans.kind == "saved" and ans.obj is not None and ans.obj.id != o.id):
+            return
+        if self.live.frames and o.id not in self._answer_ids("confirmed"):
+            self.live.absent.add(o.id)
+            self._log("search", f"not at its place: object {o.id} not seen within {cfg.at_place + 0.2:.1f} m of "
+                                f"where the map has it after {ex.looks} views; asking again without it", ex.xy)
+
+    def _answer_ids(self, kind: str) -> set[int]:
+        snap = self._snap
+        return snap.confirmed if kind == "confirmed" and snap is not None else set()
+
+    # ------------------------------------------------------------------ asking again
+    def _ask(self, force: bool = False) -> Answer:
+        """Ask the retriever again on the saved map plus what the robot has seen, when a batch of
+        views has come in since the last time (or ``force``) and the map for it changed."""
+        ex, cfg = self.explorer, self.config
+        if self._answer is not None and not force and ex.looks - self._asked_at < cfg.batch_views:
+            return self._answer
+        if self._answer is not None and ex.looks == self._asked_at:
+            return self._answer
+        self._asked_at = ex.looks
+        snap = self.live.snapshot()
+        self._snap = snap
+        if self._answer is not None and snap.signature == self._signature:
+            return self._answer
+        self._signature = snap.signature
+        ans = self._retrieve(snap)
+        if not ans.same(self._answer):
+            self._log("ask", f"asked again after {ex.looks} views, on the map and {len(snap.seen_new)} objects seen "
+                             f"that it does not explain ({len(snap.gone)} of its objects seen gone): "
+                             f"{ans.reason}", _xy(ans.obj) if ans.obj is not None else None)
+        self._answer = ans
+        return ans
+
+    def _retrieve(self, snap: Snapshot) -> Answer:
+        from capnav.retrieval.retriever import Retriever
+
+        self.asks += 1
+        if not snap.cmap.objects:
+            return Answer("none", None, "nothing left in the map or seen", len(snap.seen_new))
+        # The offline verifier judges these questions: a remote one would cost a call per batch of views.
+        r = Retriever(snap.cmap, self.embedder, None, self.retriever.config, time_aware=False)
+        q = r.query(self._parsed, robot_xy=self._start)
+        n = len(snap.seen_new)
+        if not q.found or q.chosen is None:
+            return Answer("none", None, f"no answer ({q.reason})", n)
+        o = q.chosen
+        what = f"object {o.id} ({o.caption or o.label}) at ({o.position[0]:.2f}, {o.position[1]:.2f})"
+        missing = [c for c in (self._parsed.anchor_category, self._parsed.anchor2_category)
+                   if c is not None and not len(r.of_category(c))]
+        if o.id in snap.seen_new:
+            if missing:
+                return Answer("open", o, f"{what}, seen, but no {' or '.join(missing)} seen yet to judge it by; "
+                                         "looking on", n)
+            return Answer("new", o, f"{what}, seen by the robot; {q.reason}", n)
+        if o.id in snap.confirmed:
+            return Answer("confirmed", o, f"{what}, seen again at its place; {q.reason}", n)
+        return Answer("saved", o, f"{what}, not seen yet; {q.reason}", n)
+
+    def _none_text(self, ans: Answer) -> str:
+        return f"the answer is still: {ans.reason}"
     def _region_at(self, regions: np.ndarray, xy: tuple[float, float]) -> int:
         rc = self.cmap.occupancy.spec.to_cell(np.asarray(xy, dtype=np.float64))
         if not self.cmap.occupancy.spec.inside(rc):
@@ -257,112 +350,68 @@ class ObjectSearch:
         out[ok] = fld[rc[ok, 0], rc[ok, 1]] * grid.spec.resolution
         return out
 
-    # ------------------------------------------------------------------ the goal in view
-    def _hits(self, pool: Sequence[Sighting]) -> list[Sighting]:
-        """Sightings that show the goal: its category (or a label close to its phrase) seen with
-        enough confidence, not outvoted by the other labels seen at that spot, in its colour when it
-        names one, and not another object the map holds."""
-        cfg, g = self.config, self._goal
-        good = [s for s in pool if s.score >= cfg.goal_score]
-        if not good:
-            return []
-        good = [s for s, ok in zip(good, self._is_goal([s.label for s in good]), strict=True) if ok]
-        if good and cfg.vote_radius > 0:
-            out = outvoted(good, self.explorer.sightings, self._is_goal, cfg.vote_radius)
-            good = [s for s, o in zip(good, out, strict=True) if not o]
-        if g.colours:
-            good = [s for s in good if self._colour_ok(s)]
-        return [s for s in good if not self._known_other(s)]
-
-    def _is_goal(self, labels: list[str]) -> np.ndarray:
-        """Which detector labels are the goal: its category, or labels close to its phrase."""
-        g = self._goal
-        if g.category is not None:
-            return np.array([lab == g.category for lab in labels], bool)
-        uniq = sorted(set(labels))
-        if not uniq:
-            return np.zeros(0, bool)
-        vecs = self.embedder.embed([g.phrase, *uniq]).astype(np.float64)
-        vecs /= np.maximum(np.linalg.norm(vecs, axis=1, keepdims=True), 1e-9)
-        ok = {lab for lab, c in zip(uniq, vecs[1:] @ vecs[0], strict=True) if c >= self.config.label_match}
-        return np.array([lab in ok for lab in labels], bool)
-
-    def _colour_ok(self, s: Sighting) -> bool:
-        from capnav.language.colors import color_distance, color_lab
-
-        words = [w for w in self._goal.colours if color_lab(w) is not None]
-        if not words:
-            return True
-        return any(color_distance(w, lab) <= self.config.colour_distance for w in words for lab in s.colours)
-
-    def _known_other(self, s: Sighting) -> bool:
-        """The sighting lies on a map object of its label, in that object's colours, that is not
-        the stale answer: the map already holds that one, and ranked it below the goal (or the goal
-        is not in the map). Another main colour there is something new standing where that one
-        stood (compared by the largest colour of each: a black chair is not a red one with black legs)."""
-        m = self.config.known_margin
-        for o in self.cmap.objects:
-            if o.label != s.label or (self._stale is not None and o.id == self._stale.id):
-                continue
-            if (o.extent_min[0] - m <= s.xy[0] <= o.extent_max[0] + m
-                    and o.extent_min[1] - m <= s.xy[1] <= o.extent_max[1] + m) and self._looks_like(s, o):
-                return True
-        return False
-
-    def _looks_like(self, s: Sighting, o: MapObject) -> bool:
-        from capnav.core.colour import ciede2000
-        from capnav.language.colors import object_colors
-
-        if o.id not in self._object_colours:
-            cols = object_colors(np.asarray(o.colors).reshape(-1, 3)) if len(o.colors) else []
-            self._object_colours[o.id] = [c.lab for c in cols[:1]]
-        mine = self._object_colours[o.id]
-        if not mine or not s.colours:
-            return True  # nothing to tell them apart by
-        d = float(ciede2000(np.asarray(s.colours[0]), np.asarray(mine[0]), kL=2.0))
-        return d <= self.config.colour_distance
-
-    def _at(self, s: Sighting, o: MapObject) -> bool:
-        m = self.config.at_place
-        return (o.extent_min[0] - m <= s.xy[0] <= o.extent_max[0] + m
-                and o.extent_min[1] - m <= s.xy[1] <= o.extent_max[1] + m)
-
+    # ------------------------------------------------------------------ going to the answer
     def _stop(self, ex: FrontierExplorer) -> bool:
+        """Stop a drive or a look-around when a batch of views changed the answer."""
         if self.config.budget_s is not None and time.monotonic() - self._t0 > self.config.budget_s:
             self._timed_out = True
             return True
-        return bool(self._hits(ex.new_sightings))
+        prev = self._answer
+        ans = self._ask()
+        return ans is not prev and (ans.kind in ("new", "confirmed") or not ans.same(prev))
 
-    def _approach(self, hits: list[Sighting], from_map: bool) -> SearchResult:
+    def _approach(self, ans: Answer) -> SearchResult | None:
+        """Go to the answer's footprint; None when a batch of views on the way changed the answer."""
         cfg, ex = self.config, self.explorer
-        here = np.asarray(ex.xy)
-        anchor = min(hits, key=lambda s: float(np.hypot(*(np.asarray(s.xy) - here))))
-        state = {"xy": anchor.xy}
+        assert ans.obj is not None
+        label = ans.obj.label
+        box = [np.asarray(ans.obj.extent_min[:2], np.float64), np.asarray(ans.obj.extent_max[:2], np.float64)]
+        from_map = ans.kind == "confirmed"
+
+        def refresh() -> None:
+            if from_map:
+                return
+            c = 0.5 * (box[0] + box[1])
+            near = [o for o in self.live.seen_objects()
+                    if o.label == label and float(np.hypot(*(o.position[:2] - c))) <= cfg.cluster_radius]
+            if near:
+                o = min(near, key=lambda o: float(np.hypot(*(o.position[:2] - c))))
+                box[0], box[1] = np.asarray(o.extent_min[:2], np.float64), np.asarray(o.extent_max[:2], np.float64)
 
         def target() -> tuple[float, float]:
-            pts = [s for s in self._hits(ex.sightings) if math.dist(s.xy, state["xy"]) <= cfg.cluster_radius]
-            if pts:
-                w = np.array([s.score for s in pts])
-                xy = (np.array([s.xy for s in pts]) * w[:, None]).sum(0) / w.sum()
-                state["xy"] = (float(xy[0]), float(xy[1]))
-            return state["xy"]
+            # The point of the object's footprint nearest the robot (a long bookcase is reached at its side).
+            lo, hi = box
+            inner = np.minimum(0.1, 0.5 * (hi - lo))
+            p = np.clip(np.asarray(ex.xy), lo + inner, hi - inner)
+            return float(p[0]), float(p[1])
 
-        where = "at the map's place" if from_map else "away from where the map has it"
-        self._log("found", f"a {anchor.label} ({self._goal.what}) seen at ({anchor.xy[0]:.2f}, {anchor.xy[1]:.2f}), "
-                           f"score {anchor.score:.2f}, {where}; approaching", anchor.xy)
+        def refreshed_target() -> tuple[float, float]:
+            refresh()
+            return target()
+
+        where = "seen again at the map's place" if from_map else "away from where the map has anything like it"
+        self._log("found", f"{ans.reason}; {where}; approaching", target())
         self._timed_out = False
-        st = ex.approach(target, cfg.stop_distance, self._budget_only)
+
+        def stop(e: FrontierExplorer) -> bool:  # what the robot sees on the way may change the answer
+            return self._budget_only(e) or not self._ask().same(ans)
+
+        st = ex.approach(refreshed_target, cfg.stop_distance, stop)
+        if st is Status.STOPPED and not self._timed_out:
+            return None
         goal_xy = target()
         d = math.dist(ex.xy, goal_xy)
+        centre = (float(0.5 * (box[0][0] + box[1][0])), float(0.5 * (box[0][1] + box[1][1])))
+        self._found_id = ans.obj.id if from_map else None
+        what = ans.obj.caption or ans.obj.label
         if st is Status.ARRIVED or d <= cfg.planner.reach:
-            return self._end(f"found: {self._goal.what} seen at ({goal_xy[0]:.2f}, {goal_xy[1]:.2f}); stopped "
-                             f"{d:.2f} m from it", True, goal_xy, from_map)
+            return self._end(f"found: {what} at ({centre[0]:.2f}, {centre[1]:.2f}); stopped {d:.2f} m from it",
+                             True, centre, from_map)
         if self._over(st):
-            return self._end(f"not found within budget: {self._goal.what} seen at ({goal_xy[0]:.2f}, "
-                             f"{goal_xy[1]:.2f}) but the budget ran out {d:.2f} m from it ({self._spent_text()})",
-                             False, goal_xy, from_map)
-        return self._end(f"seen but not reached: {self._goal.what} at ({goal_xy[0]:.2f}, {goal_xy[1]:.2f}); could "
-                         f"not get closer than {d:.2f} m", False, goal_xy, from_map)
+            return self._end(f"not found within budget: {what} seen at ({centre[0]:.2f}, {centre[1]:.2f}) but the "
+                             f"budget ran out {d:.2f} m from it ({self._spent_text()})", False, centre, from_map)
+        return self._end(f"seen but not reached: {what} at ({centre[0]:.2f}, {centre[1]:.2f}); could not get closer "
+                         f"than {d:.2f} m", False, centre, from_map)
 
     def _budget_only(self, ex: FrontierExplorer) -> bool:
         if self.config.budget_s is not None and time.monotonic() - self._t0 > self.config.budget_s:
@@ -386,7 +435,7 @@ class ObjectSearch:
     def _out_of_budget(self) -> SearchResult:
         looked = sum(1 for s in self.steps if s.action == "look")
         return self._end(f"not found within budget: {self._spent_text()}, looked around from {looked} places, "
-                         f"no {self._goal.what} seen that the map does not already hold")
+                         f"{self._none_text(self._answer or Answer('none', None, 'no answer'))}")
 
     def _log(self, action: str, reason: str, xy: tuple[float, float] | None = None) -> None:
         self.steps.append(SearchStep(action, reason, xy, self.driven()))
@@ -395,19 +444,18 @@ class ObjectSearch:
              from_map: bool = False) -> SearchResult:
         self._log("found" if found else "not found", reason, self.explorer.xy)
         return SearchResult(found, reason, target, self.driven(), self.steps, self.explorer.looks, from_map,
-                            self._stale.id if self._stale is not None and from_map else None)
+                            self._found_id if found and from_map else None, self.asks)
 
 
 def search_goal(cmap: CapNavMap, retriever: Any, instruction: Any, agent: Any, detector: Any,
                 config: SearchConfig | None = None) -> tuple[Any, SearchResult]:
-    """Ask the map (``retriever.query``), then go and confirm it or search. Returns the map's
-    answer (a ``QueryResult``) and the search's outcome."""
-    from capnav.retrieval.query import ParsedQuery, parse_goals
-
+    """Ask the map (``retriever.query``), then go and confirm it or search, asking again as the
+    robot sees. Returns the map's first answer (a ``QueryResult``) and the search's outcome."""
     x, y, _ = (float(v) for v in agent.pose)
     q = retriever.query(instruction, robot_xy=(x, y))
-    parsed = instruction if isinstance(instruction, ParsedQuery) else parse_goals(instruction, retriever.embedder)[0]
-    goal = Goal(parsed.category, parsed.target_phrase or parsed.text, tuple(parsed.colors))
-    chosen = q.chosen if q.found else None
-    search = ObjectSearch(cmap, agent, detector, retriever.embedder, config)
-    return q, search.run(goal, chosen, q.reason)
+    search = ObjectSearch(cmap, agent, detector, retriever, config)
+    return q, search.run(instruction, q)
+
+
+def _xy(o: MapObject) -> tuple[float, float]:
+    return float(o.position[0]), float(o.position[1])
