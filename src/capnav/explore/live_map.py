@@ -23,6 +23,7 @@ import numpy as np
 from capnav.core.frame import Frame
 from capnav.core.lazy import lazy_module
 from capnav.language import context, purpose
+from capnav.language.context import canonical_label
 from capnav.language.embedder import TextEmbedder
 from capnav.language.offline_captioner import ObservationCaptioner
 from capnav.mapping.cmap import CapNavMap
@@ -89,6 +90,9 @@ class LiveMap:
         self.old = list(cmap.objects)
         self._ev = U_._object_evidence(self.old, cfg.update)
         self.absent: set[int] = set()  # saved objects looked for at their place and not seen there
+        #: The labels worth mapping (the request's target and landmarks; None: all). Lifting a
+        #: detection onto its support costs most of a frame, and nothing else changes the answer.
+        self.kinds: set[str] | None = None
         self.frames = 0
         self._captions: dict[tuple[Any, ...], tuple[str, str, np.ndarray]] = {}
         self._context_store: dict[str, Any] = {}
@@ -97,7 +101,8 @@ class LiveMap:
     def add(self, frame: Frame, detections: list[Detection]) -> None:
         """Fuse one frame the search looked at, with the detections it made on it."""
         cfg = self.config.update
-        self._replay.dets = list(detections)
+        kinds = self.kinds
+        self._replay.dets = [d for d in detections if kinds is None or canonical_label(d.label) in kinds]
         self.mapper.integrate(frame)
         self.frames += 1
         ev = self._ev

@@ -52,6 +52,9 @@ class SearchConfig:
     stop_distance: float = 0.8  # m from the answer's footprint
     cluster_radius: float = 1.0  # m: a seen object this close to the answer (of its label) refines where it is
     batch_views: int = 4  # views between two questions to the retriever
+    second_look_prior: float = 0.9  # of a seen object of the requested kind the request did not fit
+    second_look_m: float = 1.5  # m from it to look again from
+    old_place_prior: float = 0.6  # of the place of a saved answer seen gone from afar (never looked around at)
     distance_scale: float = 4.0  # m: a place's prior is divided by 1 + path / this
     frontier_prior: float = 0.25  # prior of unseen space beyond a frontier of ``frontier_cells`` or more
     frontier_cells: int = 20  # a smaller frontier (a pocket behind furniture) has a prior in proportion
@@ -102,6 +105,10 @@ class SearchResult:
                 "driven_m": round(self.driven_m, 3), "chosen_object": self.chosen_object,
                 "target_xy": None if self.target_xy is None else [round(v, 3) for v in self.target_xy],
                 "steps": [s.to_dict() for s in self.steps]}
+
+
+#: The region of a place that is a second look at an object seen (not a room region, not a frontier).
+SECOND_LOOK = -2
 
 
 @dataclass
@@ -157,6 +164,7 @@ class ObjectSearch:
         self.asks = 0
         self._snap: Snapshot | None = None
         self._found_id: int | None = None
+        self._answered: dict[int, MapObject] = {}  # saved objects that were the answer at some time
 
     # ------------------------------------------------------------------ the request
     def run(self, instruction: str | ParsedQuery, first: QueryResult | None = None) -> SearchResult:
@@ -171,6 +179,7 @@ class ObjectSearch:
         self._parsed = instruction if isinstance(instruction, ParsedQuery) else \
             parse_goals(instruction, self.embedder)[0]
         self._start = ex.xy
+        self.live.kinds = _kinds(self._parsed)
         q = first if first is not None else self.retriever.query(instruction, robot_xy=self._start)
         self._first = q.chosen if q.found else None
         if self._first is not None:
@@ -180,6 +189,8 @@ class ObjectSearch:
         else:
             self._log("map", f"not in the map: {q.reason}")
         self._answer = Answer("saved" if self._first is not None else "none", self._first, q.reason)
+        if self._first is not None:
+            self._answered[self._first.id] = self._first
         # Look before leaving: turning in place costs no distance, and the goal may stand right here.
         self._log("look", "looking around where the request was heard", ex.xy)
         ex.observe()
@@ -209,6 +220,7 @@ class ObjectSearch:
             cands += [Place(f.target_xy, -1, cfg.frontier_prior * min(1.0, f.size / cfg.frontier_cells),
                             f"a frontier of unseen space ({f.size} cells)")
                       for f in fronts if all(math.dist(f.target_xy, v) > ex.config.visited_radius for v in visited)]
+            cands += self._second_looks(visited)
             if not cands:
                 return self._end(f"not found: every place worth looking was looked at ({len(visited)} places, "
                                  f"{ex.looks} views) and {self._none_text(ans)}")
@@ -222,7 +234,11 @@ class ObjectSearch:
             p = cands[k]
             self._log("search", f"go to ({p.xy[0]:.2f}, {p.xy[1]:.2f}), {dist[k]:.1f} m away: {p.why}, prior "
                                 f"{p.prior:.2f}, best of {len(cands)} places", p.xy)
-            st = ex.drive_to(p.xy, self._stop)
+            if p.region == SECOND_LOOK:  # the object itself stands there: look at it from a step back
+                st = ex.approach((lambda xy=p.xy: xy), cfg.second_look_m, self._stop)
+                st = Status.ARRIVED if st is Status.BLOCKED and math.dist(ex.xy, p.xy) < 2 * cfg.second_look_m else st
+            else:
+                st = ex.drive_to(p.xy, self._stop)
             visited.append(p.xy)
             self._looked_in.add(self._region_at(regions, ex.xy))
             if st is Status.BLOCKED:
@@ -231,6 +247,29 @@ class ObjectSearch:
                 self._log("look", "looking around", ex.xy)
                 ex.look_around(self._stop)
         return self._out_of_budget()
+
+    def _second_looks(self, visited: Sequence[tuple[float, float]]) -> list[Place]:
+        """Objects of the requested kind the robot saw that the retriever did not take: a first
+        glimpse (from too close, or of one side) may show a part only, of the wrong size or colour,
+        so each is worth one look around from a step back."""
+        snap, cfg = self._snap, self.config
+        kinds = {self._parsed.category, *self._parsed.category_alternatives} - {None}
+        if snap is None:
+            return []
+        out = [Place(_xy(o), SECOND_LOOK, cfg.old_place_prior,
+                     f"where the map had object {o.id} ({o.label}), seen gone from afar: a thing carried off is often "
+                     "set down nearby")
+               for o in self._answered.values() if o.id in snap.gone and o.id not in self.live.absent
+               and not any(math.dist(_xy(o), v) < 1.0 for v in visited)]
+        for n in snap.seen_new.values():
+            if n.label not in kinds or (self._answer is not None and self._answer.obj is n):
+                continue
+            xy = _xy(n)
+            if any(math.dist(xy, v) < 1.0 for v in visited):
+                continue
+            out.append(Place(xy, SECOND_LOOK, cfg.second_look_prior,
+                             f"a {n.label} seen ({n.hits} views) that the request did not fit: a better look at it"))
+        return out
 
     def _check_place(self, o: MapObject) -> None:
         """Go to a saved object's place and look around; not seen there, it is not there."""
@@ -277,6 +316,8 @@ class ObjectSearch:
                              f"that it does not explain ({len(snap.gone)} of its objects seen gone): "
                              f"{ans.reason}", _xy(ans.obj) if ans.obj is not None else None)
         self._answer = ans
+        if ans.kind == "saved" and ans.obj is not None:
+            self._answered[ans.obj.id] = ans.obj
         return ans
 
     def _retrieve(self, snap: Snapshot) -> Answer:
@@ -348,6 +389,13 @@ class ObjectSearch:
         rc = grid.spec.to_cell(np.asarray(targets, dtype=np.float64).reshape(-1, 2))
         ok = grid.spec.inside(rc)
         out[ok] = fld[rc[ok, 0], rc[ok, 1]] * grid.spec.resolution
+        # A target on an obstacle (an object to look at again): the walk to the nearest cell within a metre.
+        k = round(1.0 / grid.spec.resolution)
+        for i in np.flatnonzero(ok & ~np.isfinite(out)):
+            r, c = int(rc[i, 0]), int(rc[i, 1])
+            win = fld[max(r - k, 0):r + k + 1, max(c - k, 0):c + k + 1]
+            if np.isfinite(win).any():
+                out[i] = float(np.nanmin(np.where(np.isfinite(win), win, np.nan))) * grid.spec.resolution + 1.0
         return out
 
     # ------------------------------------------------------------------ going to the answer
@@ -368,9 +416,12 @@ class ObjectSearch:
         box = [np.asarray(ans.obj.extent_min[:2], np.float64), np.asarray(ans.obj.extent_max[:2], np.float64)]
         from_map = ans.kind == "confirmed"
 
+        seen_at = [-1]
+
         def refresh() -> None:
-            if from_map:
+            if from_map or seen_at[0] == ex.looks:  # nothing new seen since the last refresh
                 return
+            seen_at[0] = ex.looks
             c = 0.5 * (box[0] + box[1])
             near = [o for o in self.live.seen_objects()
                     if o.label == label and float(np.hypot(*(o.position[:2] - c))) <= cfg.cluster_radius]
@@ -455,6 +506,14 @@ def search_goal(cmap: CapNavMap, retriever: Any, instruction: Any, agent: Any, d
     q = retriever.query(instruction, robot_xy=(x, y))
     search = ObjectSearch(cmap, agent, detector, retriever, config)
     return q, search.run(instruction, q)
+
+
+def _kinds(q: ParsedQuery) -> set[str] | None:
+    """The categories a request's answer depends on: its target's (and their alternatives) and its
+    landmarks'; None when any category may answer (a purpose, a word for any object)."""
+    if q.category is None or q.generic or q.purpose is not None:
+        return None
+    return {c for c in (q.category, q.anchor_category, q.anchor2_category, *q.category_alternatives) if c}
 
 
 def _xy(o: MapObject) -> tuple[float, float]:

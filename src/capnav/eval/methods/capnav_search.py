@@ -1,9 +1,10 @@
 """``capnav-search``: CapNav with ``navigate --search`` as a benchmark method.
 
-The map is asked as by ``capnav``; the robot then goes there, confirms the goal with its own
-camera and the shared detector, and searches the map's rooms and unseen space when the map has
-no such object or it is not at its place (``capnav.explore.search``). Every step's reason goes
-into the subgoal's explanation. The method reads the prior map, the agent's frames and the
+The map is asked as by ``capnav``; the robot then looks, maps what it sees with the shared
+detector, and asks the same retriever again after each batch of views on the map plus what it has
+seen, going to the answer's place, or searching the map's rooms and unseen space while there is no
+answer it has seen (``capnav.explore.search``). Every step's reason goes into the subgoal's
+explanation. The method reads the prior map, the agent's frames and the
 detector's output, never the scene's truth; the harness alone judges the driven length.
 """
 
@@ -52,7 +53,7 @@ class CapNavSearchMethod:
         return SubgoalOutcome(found=res.found, reason=res.reason, target_xy=res.target_xy,
                               chosen_object=res.chosen_object, query_time_s=time.perf_counter() - t0,
                               steps=res.looks, explanation=steps,
-                              extra={"driven_m": res.driven_m, "from_map": res.from_map,
+                              extra={"driven_m": res.driven_m, "from_map": res.from_map, "asks": res.asks,
                                      "map_choice": q.chosen.id if q.chosen is not None else None})
 
 
