@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -235,7 +235,7 @@ class ObjectSearch:
             self._log("search", f"go to ({p.xy[0]:.2f}, {p.xy[1]:.2f}), {dist[k]:.1f} m away: {p.why}, prior "
                                 f"{p.prior:.2f}, best of {len(cands)} places", p.xy)
             if p.region == SECOND_LOOK:  # the object itself stands there: look at it from a step back
-                st = ex.approach((lambda xy=p.xy: xy), cfg.second_look_m, self._stop)
+                st = ex.approach(_fixed(p.xy), cfg.second_look_m, self._stop)
                 st = Status.ARRIVED if st is Status.BLOCKED and math.dist(ex.xy, p.xy) < 2 * cfg.second_look_m else st
             else:
                 st = ex.drive_to(p.xy, self._stop)
@@ -514,6 +514,11 @@ def _kinds(q: ParsedQuery) -> set[str] | None:
     if q.category is None or q.generic or q.purpose is not None:
         return None
     return {c for c in (q.category, q.anchor_category, q.anchor2_category, *q.category_alternatives) if c}
+
+
+def _fixed(xy: tuple[float, float]) -> Callable[[], tuple[float, float]]:
+    """A target that stays where it is."""
+    return lambda: xy
 
 
 def _xy(o: MapObject) -> tuple[float, float]:
