@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import pytest
+
+from capnav.core.errors import InputError
 from capnav.core.grid import FREE
 from capnav.eval.change_track import CLASSES, ChangeTrackConfig, _episodes, table
 from capnav.eval.generate import SceneTruth
@@ -55,3 +58,9 @@ def test_search_counts_only_within_three_walks() -> None:
     assert not long.success and long.success_strict is False and long.reason.startswith("reached, but drove 15.1 m")
     res = {"summaries": [], "search": {"subgoals": 2, "budget": "3x", "within_budget": 1, "reached_any_length": 2}}
     assert "within 3x 1 of 2, reached at any length 2" in table(res)
+
+
+def test_track_runs_only_its_methods() -> None:
+    assert ChangeTrackConfig(methods=("capnav-search",)).methods == ("capnav-search",)
+    with pytest.raises(InputError, match="got capnav-magic"):
+        ChangeTrackConfig(methods=("capnav-search", "capnav-magic"))

@@ -67,12 +67,14 @@ def register(app: typer.Typer) -> None:
         from capnav.core.console import make_console
 
         if changes is not None:
+            from capnav.eval.change_track import METHODS as METHODS_C
             from capnav.eval.change_track import ChangeTrackConfig, run_change_track, table
             from capnav.sim.changes import ChangeSpec
 
             check_output_dir(out, "--out")
+            chosen = METHODS_C if methods == "all" else tuple(m.strip() for m in methods.split(",") if m.strip())
             ccfg = ChangeTrackConfig(scenes=scenes, seed=seed, changes=ChangeSpec.parse(changes), per_class=per_class,
-                                     width=width, height=height, noise=noise, reuse_maps=reuse_maps)
+                                     width=width, height=height, noise=noise, reuse_maps=reuse_maps, methods=chosen)
             on_interrupt(f"the change track stopped; recordings made so far are kept in {out}/scenes")
             res_c = run_change_track(ccfg, out, progress=progress)
             make_console().print(table(res_c), markup=False, highlight=False)

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from capnav.core.atomic import write_json
+from capnav.core.errors import InputError
 from capnav.core.grid import FREE
 from capnav.eval.episode_runner import run_episode
 from capnav.eval.episodes import Episode, Subgoal
@@ -61,6 +62,12 @@ class ChangeTrackConfig:
     rooms: int | None = None
     noise: str = "default"
     reuse_maps: bool = False  # load the maps an earlier run saved in the same folder (no CPU figures then)
+    methods: tuple[str, ...] = METHODS  # the methods to run (one alone, again on the saved maps: ``reuse_maps``)
+
+    def __post_init__(self) -> None:
+        unknown = [m for m in self.methods if m not in METHODS]
+        if unknown or not self.methods:
+            raise InputError(f"the change track runs {', '.join(METHODS)}; got {', '.join(unknown) or 'none'}")
 
     def scene_seeds(self) -> list[int]:
         return [1000 * self.seed + i for i in range(self.scenes)]
@@ -201,6 +208,8 @@ def run_change_scene(scene: int, cfg: ChangeTrackConfig, out: Path, progress: bo
         episodes = _episodes(scene, cfg, man1, man2, truth)
         for name, cmap, frames in (("capnav", mu, r2), ("capnav-static", m1, r1), ("capnav-remap", mr, r2),
                                    ("capnav-search", m1, r1)):
+            if name not in cfg.methods:
+                continue
             method = create_method(name if name == "capnav-search" else "capnav")
             ctx = SceneContext(scene_seed=scene, seed=cfg.seed, sim=sim, embedder=emb, detector=detector(),
                                prior_map=cmap, occupancy=cmap.occupancy, frames=frames, workdir=folder / name)
