@@ -53,7 +53,7 @@ def test_unknown_target_and_category_only():
 
 
 @pytest.mark.parametrize(("text", "msg"), [
-    ("", "empty"), ("   ", "empty"), ("sofa " * 80, "too long"), ("a" * 400, "too long"),
+    ("", "empty"), ("   ", "empty"), ("sofa " * 130, "too long"), ("a" * 900, "too long"),
     ("去白色的沙发", "English"), ("Geh bitte zum weißen Sofa und dann zur Küche", "English"),
     ("ve al sofá blanco por favor", "English"), ("1234 !!", "no words"),
 ])
@@ -325,3 +325,15 @@ def test_a_purpose_and_its_instruction_are_embedded_in_one_model_run(monkeypatch
     assert parse_instruction(text, emb).category is not None
     emb.embed([text])  # what the retriever asks next: served from the cache
     assert len(runs) == 1 and text in runs[0], runs
+
+
+def test_a_long_spoken_request_is_read_not_refused():
+    """Spoken requests ramble: about ninety words, most of them context, still name one target.
+    (Which word is the target in such a request is the parser's work; this one is still misread.)"""
+    text = ("okay so I have been carrying these groceries up the stairs for what feels like an hour and "
+            "my arms are about to give out, my sister is coming over later tonight and I still have not "
+            "tidied anything at all, the whole flat is a mess and I do not even know where half of my "
+            "things went, but before any of that happens I really just need to put these heavy bags "
+            "down somewhere, so could you please take me over to the kitchen counter by the fridge")
+    assert 80 < len(text.split()) <= 120
+    assert validate_instruction(text) == text  # read, not refused as pasted by mistake

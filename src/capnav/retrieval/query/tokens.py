@@ -26,8 +26,10 @@ from capnav.language.context import ROOM_SYNONYMS
 from capnav.language.lexicon import load_lexicon
 from capnav.retrieval.query.model import END_OF
 
-MAX_CHARS = 300
-MAX_WORDS = 50
+# A spoken request that rambles runs to about a hundred words; past these limits the text is more
+# likely pasted by mistake, and MiniLM reads only its first 256 word pieces (about 190 words).
+MAX_CHARS = 800
+MAX_WORDS = 120
 
 _LEX = load_lexicon()
 
