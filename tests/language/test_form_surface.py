@@ -155,3 +155,32 @@ def test_a_noisy_camera_leaves_the_grain_unsaid():
     o.views[0].crop_png = buf.getvalue()
     s = ObservationCaptioner().surface(o)
     assert s.grain is None and s.detail > 0
+
+
+def test_on_a_near_black_surface_no_grain_is_claimed():
+    # Near black, one step of the measured brightness (a third of an 8-bit code of the mean of R, G
+    # and B) is as large in log brightness as the detail a grain is called at, so a face's rounding
+    # and a minified texture's aliasing read as a weave or a grain: a black wooden stool seen from
+    # afar, a black metal shade. Nothing is said there; what it is not (a weave on black plastic)
+    # still needs no texture to be read.
+    cap = ObservationCaptioner()
+    for rgb in ((24, 22, 22), (18, 18, 20)):
+        for k, pattern in enumerate(("wood", "metal", "leather", "marble")):
+            o = textured_view(make_obj(k + 1, "stool", (0, 0), (0.4, 0.4, 0.5), rgb, shading=(1.0, 1.0)), pattern)
+            s = cap.surface(o)
+            assert s.grain in (None, "plain"), (rgb, pattern, s)
+            assert not material_conflict({"wood": "wooden", "marble": "stone"}.get(pattern, pattern), s.word, s.grain)
+    # A dark brown and a bright surface keep their grain.
+    for rgb in ((60, 45, 35), (200, 190, 170)):
+        o = textured_view(make_obj(9, "stool", (0, 0), (0.4, 0.4, 0.5), rgb, shading=(1.0, 1.0)), "wood", texel=2)
+        assert cap.surface(o).grain == "grainy", rgb
+
+
+def test_a_stored_grain_on_a_near_black_object_is_read_as_unobserved():
+    # Maps described before the rule hold the grain the pixels gave; reading them applies it.
+    from capnav.language.surface import resolved_grain
+
+    s = Surface("smooth", 1.0, 0.4, 900, "woven", 22.7, 14.0)
+    assert resolved_grain(s, 5.0).grain is None  # L* 5: near black
+    assert resolved_grain(s, 40.0) == s
+    assert resolved_grain(Surface("smooth", 1.0, 0.4, 900, "plain", 1.0, 0.2), 5.0).grain == "plain"

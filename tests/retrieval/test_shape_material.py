@@ -158,3 +158,31 @@ def test_a_grain_the_pixels_contradict_is_refused_naming_the_surface(emb):
     # A chair may stand in for a sofa, but not for "the leather sofa" when its surface was not seen.
     assert not retriever(emb, {5, 6}, grain_room).query("go to the leather sofa").found
     assert retriever(emb, {5, 6}, grain_room).query("go to the sofa").chosen.id == 5
+
+
+def dark_room(keep: set[int] | None = None) -> list:
+    """Near-black things seen from afar (textures minified, not drawn texel by texel): a black
+    wooden stool, a black metal lamp, a black fabric armchair; and a bright grey plastic stool."""
+    black = (22, 20, 21)
+    objs = [
+        textured_view(make_obj(1, "stool", (1.0, 1.0), (0.35, 0.35, 0.5), black, shading=(1.0, 1.0)), "wood"),
+        textured_view(make_obj(2, "lamp", (3.0, 1.0), (0.3, 0.3, 1.1), black, shading=(1.0, 1.0)), "metal"),
+        textured_view(make_obj(3, "armchair", (5.0, 1.0), (0.8, 0.8, 0.9), black, shading=(1.0, 1.0)), "fabric"),
+        textured_view(make_obj(4, "stool", (1.0, 4.0), (0.35, 0.35, 0.5), (190, 190, 195), shading=(1.0, 1.0)),
+                      "plastic", texel=2),
+    ]
+    return [o for o in objs if keep is None or o.id in keep]
+
+
+def test_near_black_surfaces_neither_confirm_nor_refuse_a_material(emb):
+    # A black stool and a black lamp shade: their pixels' texture is below what 8 bits resolve
+    # there, so "wooden" and "metal" are unobserved, not refused as a weave.
+    only_black = retriever(emb, {1, 2, 3}, dark_room)
+    res = only_black.query("the wooden stool")
+    assert res.found and res.chosen.id == 1, res.reason
+    res = only_black.query("the black metal lamp")
+    assert res.found and res.chosen.id == 2, res.reason
+    # The bright plastic stool's plain surface still refuses "wooden".
+    res = retriever(emb, {1, 4}, dark_room).query("the wooden stool")
+    assert res.chosen.id == 1 and any("plain" in r["why"] for r in res.runners_up())
+    assert not retriever(emb, {4}, dark_room).query("the wooden stool").found

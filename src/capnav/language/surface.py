@@ -20,14 +20,15 @@ Pixels: the central three quarters of each chosen view's crop, where the colour 
 lightness) is within ``color_tolerance`` of the object's median observed colour, away from
 strong edges (the borders between faces and parts). Each view gives the RMS of the two bands over
 those pixels; the object's value is the median over views. With too few pixels, or a ratio between
-the two thresholds, nothing is said. The thresholds are measured by
+the two thresholds, nothing is said. Near black, one step of the measured brightness is coarser
+than the detail a grain is called at, so no grain is said there (``resolved_grain``). The thresholds are measured by
 ``benchmarks/measure_evidence.py`` against the simulator's materials (docs/benchmarks.md).
 """
 
 from __future__ import annotations
 
 import io
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -205,6 +206,25 @@ def grain_of(faces: list[tuple[int, float, float]], cfg: SurfaceConfig,
     return word, detail, fine
 
 
+def brightness_step(lightness: float) -> float:
+    """Per-mille step of the grain's measure (log of the mean of R, G and B, plus 4) that one third
+    of an 8-bit code makes on a grey surface of CIELAB ``lightness``: the finest brightness change
+    the measure can see there."""
+    y = ((lightness + 16.0) / 116.0) ** 3 if lightness > 8.0 else max(lightness, 0.0) / 903.3
+    v = 255.0 * (12.92 * y if y <= 0.0031308 else 1.055 * y ** (1 / 2.4) - 0.055)
+    return 1000.0 * float(np.log((v + 4.0 + 1.0 / 3.0) / (v + 4.0)))
+
+
+def resolved_grain(surface: Surface, lightness: float, config: SurfaceConfig | None = None) -> Surface:
+    """``surface`` without a woven or grainy reading where one brightness step is coarser than the
+    detail a grain is called at (``grainy_detail``): near black, a face's rounding and a minified
+    texture's aliasing look like texture. A plain reading stays (no detail at all is still seen)."""
+    cfg = config or SurfaceConfig()
+    if surface.grain in ("woven", "grainy") and brightness_step(lightness) > cfg.grainy_detail:
+        return replace(surface, grain=None)
+    return surface
+
+
 def surface_of(obj: MapObject, ref_lab: tuple[float, float, float] | None,
                config: SurfaceConfig | None = None) -> Surface:
     """The surface of ``obj`` seen in its views, around its dominant colour ``ref_lab``."""
@@ -245,7 +265,7 @@ def surface_of(obj: MapObject, ref_lab: tuple[float, float, float] | None,
             word = "woven"
         elif ratio <= cfg.smooth_ratio or fine < cfg.smooth_fine:
             word = "smooth"
-    return Surface(word, ratio, fine, total, grain, detail, fine_detail)
+    return resolved_grain(Surface(word, ratio, fine, total, grain, detail, fine_detail), float(ref[0]), cfg)
 
 
 def material_conflict(material: str, surface: str | None, grain: str | None = None) -> bool | None:

@@ -34,7 +34,7 @@ from capnav.language.embedder import TextEmbedder
 from capnav.language.form import shape_conflict
 from capnav.language.offline_captioner import ObservationCaptioner
 from capnav.language.prompts import Verdict, caption_name, parse_verdict, verification_prompt
-from capnav.language.surface import Surface, grain_agrees, material_conflict
+from capnav.language.surface import Surface, grain_agrees, material_conflict, resolved_grain
 from capnav.language.vlm.base import RateLimited, VisionLanguageModel, create_vlm
 from capnav.mapping.objects import MapObject
 from capnav.retrieval.constraints import Evidence, attribute_constraints
@@ -178,7 +178,11 @@ class OfflineVerifier(Verifier):
             if "shapes" in rec:
                 self._shapes[int(key)] = [str(w) for w in rec["shapes"]]
             if "surface" in rec:
-                self._surfaces[int(key)] = Surface.from_list(rec["surface"])
+                surf = Surface.from_list(rec["surface"])
+                own = self._colors.get(int(key))
+                if own:  # maps described before near-black grain was left unsaid
+                    surf = resolved_grain(surf, max(own, key=lambda c: c.fraction).lab[0])
+                self._surfaces[int(key)] = surf
 
     def colors(self, obj: MapObject) -> list[ColorCluster]:
         if obj.id not in self._colors:
