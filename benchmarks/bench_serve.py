@@ -9,7 +9,9 @@ with ``--pool threads``). For each row,
 every 20 ms from a process of its own (not behind the clients' event loop): a robot's watchdog,
 which must not wait behind the asks. With a robot position the server also picks the goal pose
 and plans the A* path to it; its own CPU time per ask is split into the ask (retrieval and, with
-a robot, the goal pose) and the path.
+a robot, the goal pose) and the path. The warm-up asks every (instruction, robot position) pair
+the rows time, so the server's per-start-cell caches (walking distances, goal poses) answer them;
+``--new-robots`` times positions the warm-up never used, the cost for robots that have moved.
 
 The clients are plain HTTP/1.1 over asyncio streams (``RawClient``: a request written as bytes,
 the status line, headers and a Content-Length body read back, the answer's JSON decoded), and the
@@ -25,7 +27,7 @@ p95 < 50 ms during the 64-client burst; no errors; an ask with a robot position 
 goal pose, the path apart) <= 5 ms CPU p50.
 
     .venv/bin/python benchmarks/bench_serve.py [--objects 300] [--asks 200] [--clients 1 8 64] [--seed 0]
-        [--workers 2] [--pool processes|threads] [--cli-runs 3]
+        [--workers 2] [--pool processes|threads] [--cli-runs 3] [--new-robots]
 """
 
 from __future__ import annotations
@@ -256,6 +258,9 @@ def main() -> None:
     ap.add_argument("--pool", choices=["processes", "threads"], default="processes", help="the server's pool")
     ap.add_argument("--cli-runs", type=int, default=3, help="one-shot `capnav query` runs for reference (0: none)")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--new-robots", action="store_true",
+                    help="time robot positions the warm-up never used (each moved 0.37 m, to other cells): "
+                         "the server's per-start-cell caches miss, as for robots that moved since they last asked")
     args = ap.parse_args()
 
     cmap = synthetic_map(args.objects, args.seed)
@@ -275,6 +280,8 @@ def main() -> None:
         try:
             wait_ready(url, proc)
             asyncio.run(warm(url, qs, args.workers))
+            if args.new_robots:
+                qs = [(text, [min(xy[0] + 0.37, 23.5), min(xy[1] + 0.37, 17.5)]) for text, xy in qs]
             for robot in (False, True):
                 for clients in args.clients:
                     rows.append((clients, robot, asyncio.run(burst(url, qs, clients, args.asks, robot, proc.pid))))
