@@ -16,8 +16,8 @@ the rows time, so the server's per-start-cell caches (walking distances, goal po
 The clients are plain HTTP/1.1 over asyncio streams (``RawClient``: a request written as bytes,
 the status line, headers and a Content-Length body read back, the answer's JSON decoded), and the
 watchdog the same over a blocking socket: real requests on real connections, at a fraction of the
-CPU of httpx (which cost ~3.8 ms of CPU per ask on the same 2 cores as the server, more than the
-server's event loop, and so capped the 8-client rows; bench_serve used httpx until then).
+CPU of httpx, which bench_serve used before (an ask cost httpx more CPU than the server's event
+loop spent on it, on the same 2 cores, so the 8-client rows measured the client too).
 
 Printed per row: asks/s, p50/p95 latency, errors (any non-200), /healthz p95 during the burst,
 the workers' CPU ms per ask (p50), the event loop thread's CPU per ask (with worker threads the
