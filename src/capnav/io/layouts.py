@@ -22,15 +22,34 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class Layout:
-    """A recording layout: its name, what it looks like, a test returning the evidence (or None), its reader."""
+    """A recording layout: its name, what it looks like, its reader, and how a folder shows it.
+
+    A layout told by its files alone lists them as ``parts`` (each with its alternatives) and the
+    evidence is those parts when all are there; one that needs to read a file (``meta.json``) or
+    to search sequence folders gives its own ``test``.
+    """
 
     name: str
     looks_like: str
-    evidence: Callable[[Path], str | None]
     reader: Callable[..., Recording] | None  # keyword options: intrinsics, depth_scale
     #: The files and folders (``name/``) a folder of this layout holds, each with its alternatives;
     #: what ``detect`` compares a folder with when no layout matches whole.
     parts: tuple[tuple[str, ...], ...] = ()
+    #: Files named in the evidence when present, not required (TUM's groundtruth.txt).
+    extras: tuple[str, ...] = ()
+    #: The evidence (or None) when ``parts`` cannot tell it.
+    test: Callable[[Path], str | None] | None = None
+
+    def evidence(self, root: Path) -> str | None:
+        """What in ``root`` shows this layout, or None when it is not this layout."""
+        if self.test is not None:
+            return self.test(root)
+        if not root.is_dir():
+            return None
+        has, lacks = self.missing(root)
+        if lacks:
+            return None
+        return ", ".join(has + [e for e in self.extras if _exists(root, e)])
 
     def missing(self, root: Path) -> tuple[list[str], list[str]]:
         """The parts ``root`` has (the name found) and the ones it lacks (the first alternative)."""
@@ -50,9 +69,6 @@ def _exists(root: Path, name: str) -> bool:
     return (root / name).is_file()
 
 
-def _has(root: Path, *names: str) -> bool:
-    return all((root / n).exists() for n in names)
-
 
 def _capnav(root: Path) -> str | None:
     if not (root / "meta.json").is_file():
@@ -67,10 +83,6 @@ def _capnav(root: Path) -> str | None:
     return None
 
 
-def _tum(root: Path) -> str | None:
-    return "rgb.txt, depth.txt" + (", groundtruth.txt" if _has(root, "groundtruth.txt") else "") \
-        if _has(root, "rgb.txt", "depth.txt") else None
-
 
 def _rosbag(root: Path) -> str | None:
     if root.is_file() and root.suffix == ".bag":
@@ -79,9 +91,6 @@ def _rosbag(root: Path) -> str | None:
         return "metadata.yaml and a .db3/.mcap file (ROS2 bag)"
     return None
 
-
-def _scannet(root: Path) -> str | None:
-    return "color/, depth/, pose/, intrinsic/" if _has(root, "color", "depth", "pose", "intrinsic") else None
 
 
 def _open3d(root: Path) -> str | None:
@@ -103,11 +112,6 @@ def _3dmatch(root: Path) -> str | None:
     return f"frame-XXXXXX.color/.depth/.pose files{where}"
 
 
-def _stray(root: Path) -> str | None:
-    if not _has(root, "odometry.csv", "camera_matrix.csv", "depth"):
-        return None
-    return "odometry.csv, camera_matrix.csv, depth/" + (", rgb.mp4" if _has(root, "rgb.mp4") else "")
-
 
 def _open(module: str, cls: str) -> Callable[..., Recording]:
     def make(src: Path, **opts: Any) -> Recording:
@@ -119,19 +123,20 @@ def _open(module: str, cls: str) -> Callable[..., Recording]:
 
 
 LAYOUTS: tuple[Layout, ...] = (
-    Layout("capnav-rgbd", "meta.json with format capnav-rgbd (already a CapNav dataset)", _capnav, None),
-    Layout("tum", "rgb.txt, depth.txt, groundtruth.txt", _tum, _open("capnav.io.tum", "TumReader"),
-           (("rgb.txt",), ("depth.txt",))),
-    Layout("rosbag", "a ROS1 .bag file or a ROS2 bag folder", _rosbag, None),
-    Layout("scannet", "color/, depth/, pose/, intrinsic/ (ScanNet's exported frames)", _scannet,
+    Layout("capnav-rgbd", "meta.json with format capnav-rgbd (already a CapNav dataset)", None, test=_capnav),
+    Layout("tum", "rgb.txt, depth.txt, groundtruth.txt", _open("capnav.io.tum", "TumReader"),
+           (("rgb.txt",), ("depth.txt",)), extras=("groundtruth.txt",)),
+    Layout("rosbag", "a ROS1 .bag file or a ROS2 bag folder", None, test=_rosbag),
+    Layout("scannet", "color/, depth/, pose/, intrinsic/ (ScanNet's exported frames)",
            _open("capnav.io.scannet", "ScannetReader"), (("color/",), ("depth/",), ("pose/",), ("intrinsic/",))),
-    Layout("open3d", "image/ (or color/), depth/, trajectory.log (Open3D / Redwood)", _open3d,
+    Layout("open3d", "image/ (or color/), depth/, trajectory.log (Open3D / Redwood)",
            _open("capnav.io.open3d_log", "Open3dReader"),
-           (tuple(f"{d}/" for d in COLOUR_DIRS), ("depth/",), ("trajectory.log", "*.log"))),
-    Layout("stray", "odometry.csv, camera_matrix.csv, depth/, rgb.mp4 or rgb/ (Stray Scanner)", _stray,
-           _open("capnav.io.stray", "StrayReader"), (("odometry.csv",), ("camera_matrix.csv",), ("depth/",))),
-    Layout("3dmatch", "frame-XXXXXX.color.png|jpg, .depth.png, .pose.txt, camera-intrinsics.txt", _3dmatch,
-           _open("capnav.io.threedmatch", "ThreeDMatchReader")),
+           (tuple(f"{d}/" for d in COLOUR_DIRS), ("depth/",), ("trajectory.log", "*.log")), test=_open3d),
+    Layout("stray", "odometry.csv, camera_matrix.csv, depth/, rgb.mp4 or rgb/ (Stray Scanner)",
+           _open("capnav.io.stray", "StrayReader"), (("odometry.csv",), ("camera_matrix.csv",), ("depth/",)),
+           extras=("rgb.mp4",)),
+    Layout("3dmatch", "frame-XXXXXX.color.png|jpg, .depth.png, .pose.txt, camera-intrinsics.txt",
+           _open("capnav.io.threedmatch", "ThreeDMatchReader"), test=_3dmatch),
 )
 
 
