@@ -13,6 +13,7 @@ from capnav.language.embedder import TextEmbedder
 from capnav.mapping.cmap import CameraTrajectory, CapNavMap
 from capnav.mapping.objects import MapObject, Observation
 from capnav.mapping.voxel_map import VoxelMap
+from capnav.retrieval import Retriever
 
 
 def make_obj(oid: int, label: str, center: tuple[float, float], size: tuple[float, float, float],
@@ -119,6 +120,19 @@ def captioned_map(objects: list[MapObject], emb: TextEmbedder, occupancy: Occupa
         o.caption = text
         o.embedding, o.embedding_model = v, emb.model_id
     return make_map(objects, occupancy)
+
+
+def offline_retriever(objects: list[MapObject], occupancy: OccupancyGrid | None = None) -> Retriever:
+    """A retriever over ``objects`` described as ``capnav caption`` does offline (rooms, captions,
+    MiniLM embeddings) and judged by the offline verifier: the scene a retrieval test asks."""
+    from capnav.language import create_captioner, create_embedder
+    from capnav.language.describe import describe_map
+    from capnav.retrieval import Retriever, create_verifier
+
+    cmap = make_map(objects, occupancy)
+    emb = create_embedder("minilm")
+    describe_map(cmap, None, create_captioner("offline"), emb, progress=False)
+    return Retriever(cmap, emb, create_verifier("offline", embedder=emb))
 
 
 def described_living_map(folder: Path) -> Path:

@@ -6,11 +6,9 @@ from __future__ import annotations
 
 import pytest
 
-from capnav.language import create_captioner, create_embedder
-from capnav.language.describe import describe_map
-from capnav.retrieval import Retriever, create_verifier
+from capnav.retrieval import Retriever
 from capnav.retrieval.query import parse_instruction
-from language.synth import make_map, make_obj
+from language.synth import make_obj, offline_retriever
 
 
 @pytest.mark.parametrize(("text", "category"), [
@@ -26,10 +24,7 @@ def test_the_last_noun_of_a_compound_is_the_target(text: str, category: str) -> 
 
 
 def _retriever(objs: list) -> Retriever:  # type: ignore[type-arg]
-    cmap = make_map(objs)
-    emb = create_embedder("minilm")
-    describe_map(cmap, None, create_captioner("offline"), emb, progress=False)
-    return Retriever(cmap, emb, create_verifier("offline", embedder=emb))
+    return offline_retriever(objs)
 
 
 def test_a_compound_reaches_its_head_not_its_modifier() -> None:

@@ -12,12 +12,10 @@ from __future__ import annotations
 
 import pytest
 
-from capnav.language import create_captioner, create_embedder
-from capnav.language.describe import describe_map
-from capnav.retrieval import Retriever, create_verifier
+from capnav.retrieval import Retriever
 from capnav.retrieval.query import parse as parse_mod
 from capnav.retrieval.query import parse_goals, parse_instruction
-from language.synth import grid_with_walls, make_map, make_obj
+from language.synth import grid_with_walls, make_obj, offline_retriever
 
 needs_spacy = pytest.mark.skipif(parse_mod.load_parser() is None, reason="spaCy's English pipeline is not installed")
 
@@ -39,10 +37,7 @@ def retriever() -> Retriever:
         make_obj(34, "desk", (7.5, 3.8), (1.2, 0.6, 0.75), (200, 200, 200)),
     ]
     occ = grid_with_walls(-1, -1, 10, 7, [(3.8, (2.5, 3.5)), (5.6, (0.5, 1.5))])
-    cmap = make_map(objs, occ)
-    emb = create_embedder("minilm")
-    describe_map(cmap, None, create_captioner("offline"), emb, progress=False)
-    r = Retriever(cmap, emb, create_verifier("offline", embedder=emb))
+    r = offline_retriever(objs, occ)
     rooms = {o.id: r.scene.rooms[k] for k, o in enumerate(r.objects)}
     assert rooms[1] == "kitchen" and rooms[34] == "office" and rooms[21] is None, rooms
     return r

@@ -8,11 +8,9 @@ from __future__ import annotations
 
 import pytest
 
-from capnav.language import create_captioner, create_embedder
-from capnav.language.describe import describe_map
 from capnav.language.purpose import is_placing
-from capnav.retrieval import Retriever, create_verifier
-from language.synth import grid_with_wall, make_map, make_obj
+from capnav.retrieval import Retriever
+from language.synth import grid_with_wall, make_obj, offline_retriever
 
 NIGHTSTAND, COFFEE_TABLE, DESK = 3, 7, 10
 SURFACES = {"table", "coffee table", "nightstand", "desk", "counter"}
@@ -32,10 +30,7 @@ def retriever() -> Retriever:
         make_obj(9, "armchair", (2.8, 2.0), (0.8, 0.8, 0.9), (170, 50, 50)),
         make_obj(DESK, "desk", (3.2, 4.2), (1.2, 0.6, 0.75), (90, 60, 40)),
     ]
-    cmap = make_map(objs, grid_with_wall(-1, -1, 9, 7))
-    emb = create_embedder("minilm")
-    describe_map(cmap, None, create_captioner("offline"), emb, progress=False)
-    return Retriever(cmap, emb, create_verifier("offline", embedder=emb))
+    return offline_retriever(objs, grid_with_wall(-1, -1, 9, 7))
 
 
 @pytest.mark.parametrize(("activity", "placing"), [

@@ -7,17 +7,12 @@ from __future__ import annotations
 
 import pytest
 
-from capnav.language import create_captioner, create_embedder
-from capnav.language.describe import describe_map
-from capnav.retrieval import Retriever, create_verifier
-from language.synth import grid_with_walls, make_map, make_obj
+from capnav.retrieval import Retriever
+from language.synth import grid_with_walls, make_obj, offline_retriever
 
 
 def _retriever(objs: list) -> Retriever:  # type: ignore[type-arg]
-    cmap = make_map(objs, grid_with_walls(-1, -1, 10, 7, [(4.0, (2.5, 3.5)), (6.0, (2.5, 3.5))]))
-    emb = create_embedder("minilm")
-    describe_map(cmap, None, create_captioner("offline"), emb, progress=False)
-    return Retriever(cmap, emb, create_verifier("offline", embedder=emb))
+    return offline_retriever(objs, grid_with_walls(-1, -1, 10, 7, [(4.0, (2.5, 3.5)), (6.0, (2.5, 3.5))]))
 
 
 @pytest.fixture(scope="module")

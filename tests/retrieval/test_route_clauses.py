@@ -12,11 +12,9 @@ from __future__ import annotations
 
 import pytest
 
-from capnav.language import create_captioner, create_embedder
-from capnav.language.describe import describe_map
-from capnav.retrieval import Retriever, create_verifier
+from capnav.retrieval import Retriever
 from capnav.retrieval.query import parse as parse_mod
-from language.synth import grid_with_wall, make_map, make_obj
+from language.synth import grid_with_wall, make_obj, offline_retriever
 
 needs_spacy = pytest.mark.skipif(parse_mod.load_parser() is None, reason="spaCy's English pipeline is not installed")
 
@@ -37,10 +35,7 @@ def retriever() -> Retriever:
         make_obj(9, "coffee table", (6.4, 3.0), (1.0, 0.6, 0.45), (120, 80, 50)),
         make_obj(WASHER, "washing machine", (1.6, 0.5), (0.6, 0.6, 0.85), (240, 240, 240)),
     ]
-    cmap = make_map(objs, grid_with_wall(-1, -1, 9, 7, wall_x=4.0, door=(2.5, 3.5)))
-    emb = create_embedder("minilm")
-    describe_map(cmap, None, create_captioner("offline"), emb, progress=False)
-    r = Retriever(cmap, emb, create_verifier("offline", embedder=emb))
+    r = offline_retriever(objs, grid_with_wall(-1, -1, 9, 7, wall_x=4.0, door=(2.5, 3.5)))
     rooms = {o.id: r.scene.rooms[k] for k, o in enumerate(r.objects)}
     assert rooms[5] == "living room" and rooms[1] == "kitchen", rooms  # the scene types its rooms
     return r
