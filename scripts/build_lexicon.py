@@ -197,6 +197,7 @@ def build(wordnet: Path) -> dict[str, Any]:
         out["kinds"] = _kinds(wn, out["forms"])
         out["placing"] = _placing(wn)
         out["body"] = _body(wn, (wordnet / "noun.exc").read_text().splitlines())
+        out["materials"] = _materials(wn, out["forms"], out["labels"])
         out["forms"] = dict(sorted(out["forms"].items()))
         return out
 
@@ -388,6 +389,100 @@ def _placing(wn: Any) -> list[str]:
         for s in [wn.synset(n), *wn.synset(n).closure(lambda x: x.hyponyms())]:
             out |= {_form(lem.name()) for lem in s.lemmas()}
     return sorted(f for f in out if f.replace(" ", "").isalpha() and f == f.lower())
+
+
+#: The materials the surface test knows (``capnav.language.surface``), each with the WordNet
+#: synsets it is: every word under one of them names that material. ``alloy.n.01`` and
+#: ``metallic_element.n.01`` hold steel, brass, iron and chromium; ``ceramic_ware.n.01`` holds
+#: porcelain and earthenware; stone has no surface test (``rock.n.02``: granite, slate) and is
+#: named only so that it reads as a material, neither confirmed nor refused by the pixels. Paper
+#: is left to its own word: WordNet files pads, tablets and cards as kinds of paper.
+MATERIAL_ROOTS: dict[str, list[str]] = {
+    "wood": ["wood.n.01"], "fabric": ["fabric.n.01"], "leather": ["leather.n.01"], "velvet": ["velvet.n.01"],
+    "metal": ["metal.n.01", "alloy.n.01", "metallic_element.n.01"], "glass": ["glass.n.01"],
+    "marble": ["marble.n.01"], "plastic": ["plastic.n.01"], "ceramic": ["ceramic.n.01", "ceramic_ware.n.01"],
+    "wool": ["wool.n.01"], "cotton": ["cotton.n.01"], "stone": ["rock.n.02"],
+}
+#: Under a material, things made of it rather than kinds of it: a piece of cloth (a towel, a rag).
+NOT_MATERIALS = {"piece_of_cloth.n.01"}
+#: How many of a word's senses (WordNet's order: most frequent first) are read for a material:
+#: "pine" is a tree first and its wood second.
+MATERIAL_SENSES = 2
+
+
+def _materials(wn: Any, forms: dict[str, str], labels: dict[str, str]) -> dict[str, str]:
+    """Material words -> the material they are ("velvety" velvet, "oak" wood, "suede" leather,
+    "chenille" fabric, "brass" metal), from WordNet: a word is a material when one of its first
+    ``MATERIAL_SENSES`` senses lies under a material's synsets (the nearest one above it wins, so
+    velvet stays velvet rather than fabric), for an adjective through the noun it is derived from
+    or pertains to. Category and detector-class forms, colour words ("walnut", "gold", "ivory"
+    stay colours) and room words are left out: the word must not change what else it says."""
+    by_synset = {n: m for m, names in MATERIAL_ROOTS.items() for n in names}
+    colour_words = set(LEXICON) | set(ALIASES)
+
+    def kind_of_material(s: Any, root: Any) -> bool:
+        # A substance, a wood named by its tree (teak), or of the root's own kind (fabrics are
+        # artifacts); not a thing made of it (paper's pads and cards are artifacts, paper is not).
+        return bool(s.lexname() in ("noun.substance", "noun.plant") or s.lexname() == root.lexname())
+
+    def nearest(s: Any) -> str | None:
+        """The material of the nearest root above ``s`` (none through a thing made of it)."""
+        frontier, seen = [s], {s}
+        while frontier:
+            hit = sorted({by_synset[x.name()] for x in frontier
+                          if x.name() in by_synset and kind_of_material(s, wn.synset(x.name()))})
+            if hit:
+                return hit[0]
+            nxt = []
+            for x in frontier:
+                nxt += [h for h in x.hypernyms() + x.instance_hypernyms()
+                        if h not in seen and h.name() not in NOT_MATERIALS]
+            seen |= set(nxt)
+            frontier = nxt
+        return None
+
+    def count(word: str, pos: str) -> int:
+        return sum(lem.count() for s in wn.synsets(word, pos) for lem in s.lemmas() if lem.name().lower() == word)
+
+    def material(word: str) -> str | None:
+        # An adjective is read as one ("metallic", not the metallic fabric); a word used more often
+        # as a verb in the sense-tagged corpus ("lead", "iron") says something else first.
+        senses = wn.synsets(word, "a") + wn.synsets(word, "s") or wn.synsets(word, "n")
+        if not senses or count(word, "v") > sum(count(word, p) for p in ("n", "a", "s")):
+            return None
+        for s in senses[:MATERIAL_SENSES]:
+            nouns = [s] if s.pos() == "n" else [
+                r.synset() for lem in s.lemmas() if lem.name().lower() == word
+                for r in lem.pertainyms() + lem.derivationally_related_forms() if r.synset().pos() == "n"]
+            for n in nouns:
+                m = nearest(n)
+                if m is not None:
+                    return m
+        return None
+
+    words: set[str] = set()
+    for names in MATERIAL_ROOTS.values():
+        for n in names:
+            root = wn.synset(n)
+            for s in [root, *root.closure(lambda x: [h for h in x.hyponyms() if h.name() not in NOT_MATERIALS])]:
+                if not kind_of_material(s, root):
+                    continue
+                for lem in s.lemmas():
+                    words.add(lem.name())
+                    words |= {r.name() for r in lem.derivationally_related_forms() if r.synset().pos() in "as"}
+                    words |= {r.name() for r in lem.pertainyms()}
+    for s in wn.all_synsets("a"):  # adjectives that pertain to a material ("woollen", "ceramic")
+        for lem in s.lemmas():
+            if any(p.synset().name() in by_synset for p in lem.pertainyms()):
+                words.add(lem.name())
+    out: dict[str, str] = {}
+    for w in sorted(words):
+        if not w.isalpha() or w != w.lower() or w in forms or w in labels or w in colour_words or w in ROOM_WORDS:
+            continue
+        m = material(w)
+        if m is not None:
+            out[w] = m
+    return out
 
 
 def _is_name(wn: Any, lemma: str) -> bool:

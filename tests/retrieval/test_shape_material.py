@@ -186,3 +186,35 @@ def test_near_black_surfaces_neither_confirm_nor_refuse_a_material(emb):
     res = retriever(emb, {1, 4}, dark_room).query("the wooden stool")
     assert res.chosen.id == 1 and any("plain" in r["why"] for r in res.runners_up())
     assert not retriever(emb, {4}, dark_room).query("the wooden stool").found
+
+
+@pytest.mark.parametrize(("text", "oid"), [
+    ("the chenille armchair", 1),  # a fabric by name
+    ("take me to the tweedy-looking... no, the tweed armchair", 1),
+    ("the armchair in suede", 2),  # a leather
+    ("my leathery pink armchair", 2),
+])
+def test_material_words_beyond_the_plain_names_reach_their_material(emb, text, oid):
+    """WordNet's material words (a kind of fabric or leather, an adjective derived from one) are
+    read as the material the surface test knows, so they choose between the lookalikes."""
+    res = retriever(emb).query(text)
+    assert res.found and res.chosen.id == oid, res.reason
+    assert "material" in res.terms, res.terms  # judged as a material (leather's mottle: 0.5 here)
+
+
+def test_a_kind_of_material_the_pixels_contradict_is_refused(emb):
+    only_woven = retriever(emb, {1, 3, 4, 5, 6})
+    res = only_woven.query("the suede armchair")
+    assert not res.found and "woven" in res.reason
+
+
+def test_material_words_are_read_as_their_material_and_nothing_else():
+    from capnav.retrieval.query import parse_instruction
+
+    assert parse_instruction("the sofa with the velvety feel").materials == ["velvet"]
+    assert parse_instruction("a teak side table").materials == ["wood"]
+    assert parse_instruction("the brass floor lamp").materials == ["metal"]
+    # verbs first ("lead me"), colour words ("walnut") and category words keep their role
+    assert parse_instruction("lead me to the sofa").materials == []
+    walnut = parse_instruction("the walnut table")
+    assert walnut.materials == [] and walnut.colors

@@ -53,6 +53,9 @@ class Lexicon:
     placing: frozenset[str] = frozenset()
     #: nouns for parts of the body, with plurals ("feet": noun.body in WordNet)
     body: frozenset[str] = frozenset()
+    #: a material word -> the material the surface test knows ("velvety" velvet, "suede" leather,
+    #: "teak" wood, "chenille" fabric, "brass" metal; WordNet's, see build_lexicon)
+    materials: dict[str, str] = field(default_factory=dict)
     load_seconds: float = 0.0
 
     def category_alternatives(self, category: str, form: str | None = None) -> dict[str, float]:
@@ -89,7 +92,8 @@ def load_lexicon() -> Lexicon:
                   growth=dict(raw.get("growth", {})), labels=dict(raw.get("labels", {})),
                   persons=frozenset(raw.get("persons", [])),
                   kinds={k: tuple(v) for k, v in raw.get("kinds", {}).items()},
-                  placing=frozenset(raw.get("placing", [])), body=frozenset(raw.get("body", [])))
+                  placing=frozenset(raw.get("placing", [])), body=frozenset(raw.get("body", [])),
+                  materials=dict(raw.get("materials", {})))
     object.__setattr__(lex, "load_seconds", time.perf_counter() - t0)
     return lex
 

@@ -24,7 +24,7 @@ from capnav.retrieval.query.tokens import (
     _GROWTH,
     _GROWTH_TOKENS,
     _LEX,
-    _MATERIALS,
+    _MATERIAL_OF,
     _ORDINALS,
     _PROXIMITY,
     _RELATIONS,
@@ -38,6 +38,7 @@ from capnav.retrieval.query.tokens import (
     _other_object,
     _room_before,
     _size_word,
+    materials_in,
     validate_instruction,
 )
 
@@ -289,7 +290,7 @@ def _attributes_outside(q: ParsedQuery, head: str, activity: str) -> None:
     words = (head[:k] + " " + head[k + len(activity):]).split()
     q.colors = _colors(words)
     q.shapes = list(dict.fromkeys(_SHAPES[w] for w in words if w in _SHAPES))
-    q.materials = [w for w in words if w in _MATERIALS]
+    q.materials = materials_in(words)
     q.size_word = _size_word(words)
 
 
@@ -404,7 +405,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     q.shapes = list(dict.fromkeys(_SHAPES[w] for w in words if w in _SHAPES))
     if "l-shaped" in head or "l shaped" in head:
         q.shapes = list(dict.fromkeys([*q.shapes, "L-shaped"]))
-    q.materials = [w for w in words if w in _MATERIALS]
+    q.materials = materials_in(words)
     cat, span, fuzzy = _find_category(words)
     other = _other_object(words, span) if cat in BY_NAME else None  # a class's own compound names it
     if other is not None:
@@ -420,7 +421,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
         grams = {" ".join(words[i:i + n]) for n in (1, 2, 3) for i in range(len(words) - n + 1)}
         q.shapes = list(dict.fromkeys([*q.shapes, *sorted({_GROWTH[g] for g in grams if g in _GROWTH})]))
     known = (set(_FILLER) | set(LEXICON) | set(ALIASES) | set(_SHAPES) | _SIZE_TOKENS | set(_SUPERLATIVE)
-             | _MATERIALS | _COMMON_ADJECTIVES | {w for c in q.colors for w in c.split()}
+             | set(_MATERIAL_OF) | _COMMON_ADJECTIVES | {w for c in q.colors for w in c.split()}
              | (_GROWTH_TOKENS if cat == "plant" else set())
              | {w for w in words if re.fullmatch(r"[a-z]+-colou?red", w)})
     if cat is not None and span is not None:

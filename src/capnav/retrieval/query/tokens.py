@@ -138,6 +138,15 @@ _RELATIONS = [END_OF, "in front of", "facing", "next to", "close to", "beside", 
               "opposite", "across from", "alongside", "against"]
 _MATERIALS = {"wooden", "wood", "leather", "fabric", "velvet", "metal", "glass", "marble", "plastic",
               "ceramic", "stainless", "steel", "laminate", "cotton", "acrylic", "paper", "terracotta", "chrome"}
+#: Every other material word WordNet has, spoken as the material the surface test knows
+#: ("velvety" -> velvet, "suede" -> leather, "teak" -> wood; the lexicon's ``materials``).
+_MATERIAL_OF = {**_LEX.materials, **{w: w for w in _MATERIALS}}
+
+
+def materials_in(words: list[str]) -> list[str]:
+    """The materials ``words`` name, once each, in order: the plain words as spoken, the others
+    as the material they are ("a velvety suede chair" -> velvet, leather)."""
+    return list(dict.fromkeys(_MATERIAL_OF[w] for w in words if w in _MATERIAL_OF))
 _FILLER = {"go", "to", "the", "a", "an", "please", "find", "navigate", "take", "me", "walk", "head", "move",
            "drive", "could", "you", "can", "would", "kindly", "toward", "towards", "over", "there", "that",
            "one", "of", "is", "which", "i", "want", "need", "get", "bring", "robot", "hey", "and", "with",
@@ -394,5 +403,5 @@ def attribute_word(word: str) -> bool:
     """Whether the mapping would read ``word`` as an attribute of the target: a colour, shape,
     size, material or growth word ("blue", "round", "big", "velvet", "prickly")."""
     w = word.lower()
-    return bool(w in _SHAPES or w in _SIZE_WORDS or w in _SUPERLATIVE or w in _MATERIALS or w in _GROWTH
+    return bool(w in _SHAPES or w in _SIZE_WORDS or w in _SUPERLATIVE or w in _MATERIAL_OF or w in _GROWTH
                 or _color_name(w))
