@@ -154,3 +154,43 @@ def test_floor_distances_give_the_floats_of_the_heap_dijkstra_and_the_per_box_lo
     ref = np.array([box_min(field, spec, lo, hi, RING) for lo, hi in zip(los, his, strict=True)])
     np.testing.assert_array_equal(floor.from_objects(pair), ref)
     assert 0 < finite < 6 * len(los) and ring > 0  # unreached boxes, and one measured at its ring
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_a_walk_stopped_once_some_objects_are_measured_gives_their_floats(seed: int) -> None:
+    # "The closest chair" measures the chairs only: the walk stops once each holds an expanded
+    # cell. Their floats are the whole walk's; the others are nan, unless one of the asked is never
+    # reached (in the closed room, or off the grid): then the walk ran on and every object has its
+    # value. A later ask from the same cell fills in what the first left out.
+    rng = np.random.default_rng(30 + seed)
+    spec = GridSpec(0.0, 0.0, 0.1, 30, 45)
+    dom = rooms_with_doors(rng, 30, 45)
+    dom[18:27, 30:39] = False
+    dom[19:26, 31:38] = True
+    occ = OccupancyGrid(spec, np.where(dom, FREE, OCCUPIED).astype(np.uint8))
+    los = rng.uniform([-0.4, -0.4], [4.4, 2.9], (40, 2))
+    his = los + rng.uniform(0.05, 0.6, (40, 2))
+    los[-2:] = [spec.to_world(np.array([22, 35])), [-3.0, -3.0]]  # in the closed room; off the grid
+    his[-2:] = [spec.to_world(np.array([24, 36])), [-2.0, -2.0]]
+    whole = FloorDistances(occ, los, his, cache_size=0)
+    free = np.argwhere(whole.domain)
+    stopped = 0
+    for k, (r, c) in enumerate(free[rng.choice(len(free), size=8, replace=False)]):
+        xy = spec.to_world(np.array([r, c]))
+        robot = (float(xy[0]), float(xy[1]))
+        ref = whole.from_point(robot)
+        among = rng.choice(len(los) - 2, size=1 + k % 4, replace=False)
+        if k % 3 == 2:
+            among = np.append(among, len(los) - 2 + k % 2)  # one no walk reaches (or only its ring)
+        part = FloorDistances(occ, los, his)
+        got = part.from_point(robot, among)
+        np.testing.assert_array_equal(got[among], ref[among])
+        rest = np.setdiff1d(np.arange(len(los)), among)
+        if np.isnan(got).any():
+            stopped += 1
+            assert np.isfinite(ref[among]).all()  # stopped early only when every asked one was reached
+        else:
+            np.testing.assert_array_equal(got, ref)
+        np.testing.assert_array_equal(part.from_point(robot, rest)[rest], ref[rest])  # filled in from here
+        np.testing.assert_array_equal(part.from_point(robot), ref)
+    assert stopped > 0

@@ -47,8 +47,21 @@ def walk_base(domain: NDArray[np.bool_]) -> NDArray[np.float64]:
 @njit(cache=True, nogil=True)
 def _walk(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int64], limit: float) -> NDArray[np.float64]:
     """Cells from the nearest seed, on a copy of ``base`` (padded, ``cols`` + 2 wide)."""
+    return _walk_until(base, cols, seeds, limit, np.zeros(0, np.uint8), np.zeros((0, 4), np.int64))[0]
+
+
+@njit(cache=True, nogil=True)
+def _walk_until(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int64], limit: float,
+                mark: NDArray[np.uint8], want: NDArray[np.int64]) -> tuple[NDArray[np.float64], bool]:
+    """``_walk``, stopped once a cell of every box of ``want`` (r0, c0, r1, c1 inclusive, grid
+    cells; ``mark`` is 1 on their padded cells, or empty for no stop) is expanded; whether it ran
+    to the end. When the last box's first cell is expanded at ``d`` in bucket k, every cell below
+    k + 1 already holds its final distance (set from buckets before k) and every other cell holds
+    at least k + 1 > ``d``: each box's minimum over ``dist`` is then final."""
     w = cols + 2
     dist = base.copy()
+    left = want.shape[0]
+    done = np.zeros(left, np.bool_)
     # Three buckets suffice: a cell expanded from bucket k lands in k + 1 or k + 2 (steps < 2); a
     # bucket holds a cell at most once. They rotate (the one done becomes k + 3's), so a push
     # picks its bucket by one comparison, with no modulo.
@@ -76,6 +89,15 @@ def _walk(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int64], limit:
             # or too far.
             if du < kf or du > limit:
                 continue
+            if left > 0 and mark[u]:  # u is final: the boxes that hold it have their minimum
+                ur = u // w - 1
+                uc = u - (ur + 1) * w - 1
+                for i in range(want.shape[0]):
+                    if not done[i] and want[i, 0] <= ur <= want[i, 2] and want[i, 1] <= uc <= want[i, 3]:
+                        done[i] = True
+                        left -= 1
+                if left == 0:
+                    return dist, False
             for m in range(8):
                 if m == 0:
                     v, nd = u - w - 1, du + _SQRT2
@@ -107,7 +129,7 @@ def _walk(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int64], limit:
         cur, nx1, nx2 = nx1, nx2, cur
         fc, f1, f2 = f1, f2, 0
         k += 1
-    return dist
+    return dist, True
 
 
 @njit(cache=True, nogil=True)
@@ -160,6 +182,46 @@ def walk_box_minima(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int6
 
 
 @njit(cache=True, nogil=True)
+def walk_box_minima_of(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int64], boxes: NDArray[np.int64],
+                       grown: NDArray[np.int64], scale: float, grow: float, among: NDArray[np.int64]
+                       ) -> NDArray[np.float64]:
+    """``walk_box_minima`` for the boxes ``among`` only (nan for the others), the walk stopped
+    once each of them holds an expanded cell: "the closest chair" needs the chairs, not the
+    floor beyond the farthest one. The same floats for ``among``; when a box of them is never
+    reached the walk runs to the end and every box gets its value."""
+    w = cols + 2
+    mark = np.zeros(base.shape[0], np.uint8)
+    want = np.empty((among.shape[0], 4), np.int64)
+    m = 0
+    for j in range(among.shape[0]):
+        bx = boxes[among[j]]
+        if bx[2] < bx[0] or bx[3] < bx[1]:
+            continue  # an empty box holds no cell: it cannot stop the walk
+        want[m] = bx
+        m += 1
+        for r in range(bx[0], bx[2] + 1):
+            o = (r + 1) * w + 1
+            for c in range(bx[1], bx[3] + 1):
+                mark[o + c] = 1
+    if m < among.shape[0]:  # an empty box is reached only through its ring: the whole walk
+        m = 0
+    dist, whole = _walk_until(base, cols, seeds, np.inf, mark, want[:m])
+    out = np.full(boxes.shape[0], np.nan)
+    for j in range(boxes.shape[0] if whole else 0):
+        out[j] = np.inf
+    for j in range(boxes.shape[0] if whole else among.shape[0]):
+        i = j if whole else among[j]
+        best = _padded_min(dist, w, boxes[i])
+        if best < np.inf:
+            out[i] = best * scale
+        elif whole:
+            best = _padded_min(dist, w, grown[i])
+            if best < np.inf:
+                out[i] = best * scale + grow
+    return out
+
+
+@njit(cache=True, nogil=True)
 def box_minima(field: NDArray[np.float64], boxes: NDArray[np.int64], grown: NDArray[np.int64], grow: float
                ) -> NDArray[np.float64]:
     """Per box (r0, c0, r1, c1 inclusive; empty when r1 < r0 or c1 < c0): the smallest value of
@@ -179,4 +241,4 @@ def box_minima(field: NDArray[np.float64], boxes: NDArray[np.int64], grown: NDAr
     return out
 
 
-__all__ = ["BLOCKED", "box_minima", "grid_geodesic", "walk_base", "walk_box_minima"]
+__all__ = ["BLOCKED", "box_minima", "grid_geodesic", "walk_base", "walk_box_minima", "walk_box_minima_of"]

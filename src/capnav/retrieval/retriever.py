@@ -119,13 +119,17 @@ class Retriever:
         d = np.hypot(self.cells[:, 0] - rc[0], self.cells[:, 1] - rc[1])
         return np.asarray(d * self.grid.resolution, dtype=np.float64)
 
-    def robot_distance(self, robot_xy: tuple[float, float]) -> tuple[NDArray[np.float64], str]:
+    def robot_distance(self, robot_xy: tuple[float, float], among: NDArray[np.intp] | None = None
+                       ) -> tuple[NDArray[np.float64], str]:
         """Distances from the robot to every object and what they measure: along the floor
         (``RetrievalConfig.distance == "walking"``, when the map has a grid and the robot stands
-        where a walk starts) else eq. 17's straight grid distance."""
+        where a walk starts) else eq. 17's straight grid distance. With ``among`` (object indices)
+        only those are sure to be measured: a walk stops once they are (the others may be nan).
+        Whether it is a walk does not depend on ``among``: a walk that stopped early reached one of
+        them, and one that reached none of them ran to the end and measured every object."""
         floor = self.floor_distances()
         if floor is not None:
-            d = floor.from_point(robot_xy)
+            d = floor.from_point(robot_xy, among)
             if np.isfinite(d).any():
                 return np.where(np.isfinite(d), d, self.grid_distance(robot_xy) + 1e6), "walking"
         return self.grid_distance(robot_xy), "straight"
@@ -219,7 +223,7 @@ class Retriever:
             # Measured as the ranking measured it: a walk (cached by the distance constraint) when
             # the answer was ranked by distance, else eq. 17's straight grid distance, so that a
             # sentence's distance never costs a search over the whole floor.
-            d, dist_kind = self.robot_distance(robot_xy) if mode == "closest" \
+            d, dist_kind = self.robot_distance(robot_xy, np.array([chosen_i])) if mode == "closest" \
                 else (self.grid_distance(robot_xy), "straight")
             dist = float(d[chosen_i])
         reason = self._explain(q, chosen_i, s, rk, notes, verdict_reason, dist, verifier, runners, judged,

@@ -118,29 +118,44 @@ class FloorDistances:
         self._cache: dict[tuple[int, ...], NDArray[np.float64]] = {}
         self._size = cache_size
 
-    def _per_object(self, key: tuple[int, ...], los: NDArray[np.float64], his: NDArray[np.float64]
-                    ) -> NDArray[np.float64]:
+    def _per_object(self, key: tuple[int, ...], los: NDArray[np.float64], his: NDArray[np.float64],
+                    among: NDArray[np.intp] | None = None) -> NDArray[np.float64]:
+        """The walk's minimum per object (nan where not measured: only ``among`` was asked for)."""
         hit = self._cache.pop(key, None)
-        if hit is None:
+        missing = None if hit is None else np.isnan(hit if among is None else hit[among])
+        if hit is None or (missing is not None and missing.any()):
             seeds = box_seeds(self.domain, self.spec, los, his)
             if len(seeds) == 0:
-                hit = np.full(len(self._boxes), np.inf)
-            else:
+                new = np.full(len(self._boxes), np.inf)
+            elif among is None:
                 from capnav.core.geodesic import walk_box_minima
 
-                hit = walk_box_minima(self._base, self.spec.cols, seeds, self._boxes, self._grown,
+                new = walk_box_minima(self._base, self.spec.cols, seeds, self._boxes, self._grown,
                                       self.spec.resolution, RING)
+            else:
+                from capnav.core.geodesic import walk_box_minima_of
+
+                ask = np.asarray(among if hit is None else among[missing], dtype=np.int64)
+                new = walk_box_minima_of(self._base, self.spec.cols, seeds, self._boxes, self._grown,
+                                         self.spec.resolution, RING, ask)
+            if hit is not None:  # what an earlier, partial walk from here measured stays
+                new = np.where(np.isnan(new), hit, new)
+            hit = new
             while self._cache and len(self._cache) >= self._size:
                 self._cache.pop(next(iter(self._cache)))  # the least recently used source
         if self._size > 0:
             self._cache[key] = hit
         return hit
 
-    def from_point(self, xy: tuple[float, float]) -> NDArray[np.float64]:
-        """Metres along the floor from ``xy`` to each object (inf when no walk reaches it)."""
+    def from_point(self, xy: tuple[float, float], among: NDArray[np.intp] | None = None) -> NDArray[np.float64]:
+        """Metres along the floor from ``xy`` to each object (inf when no walk reaches it). With
+        ``among`` (object indices) the walk may stop once those are measured: the others are then
+        nan, unless no walk reaches one of ``among`` (then the walk covered the floor and every
+        object has its value)."""
         p = np.asarray(xy, dtype=np.float64).reshape(1, 2)
         rc = self.spec.to_cell(p[0])
-        return self._per_object(("point", int(rc[0]), int(rc[1])), p, p)  # type: ignore[arg-type]
+        idx = None if among is None else np.unique(np.asarray(among, dtype=np.intp))
+        return self._per_object(("point", int(rc[0]), int(rc[1])), p, p, idx)  # type: ignore[arg-type]
 
     def from_objects(self, idx: NDArray[np.intp]) -> NDArray[np.float64]:
         """Metres along the floor from the nearest of the objects ``idx`` to each object."""

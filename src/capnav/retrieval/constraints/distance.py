@@ -27,7 +27,7 @@ class Distance(RankingConstraint):
         if st.robot_xy is None:
             st.notes.append(f"'{q.proximity}' needs a robot position (--robot X,Y); ranked by similarity instead")
             return
-        full, kind = st.r.robot_distance(st.robot_xy)
+        full, kind = st.r.robot_distance(st.robot_xy, st.pool)  # the walk stops once the pool is measured
         d = full[st.pool]
         far = q.proximity == "farthest"
         st.group_keys.append(-d if far else d)
