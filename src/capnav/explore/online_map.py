@@ -123,7 +123,7 @@ class OnlineMap:
         """FREE / OCCUPIED / UNKNOWN per cell under the evidence rule of the module docstring.
 
         ``forgive_contacts``: leave out the contact marks on cells the depth has seen free in at
-        least ``forgive_free_frames`` frames and never as an obstacle. A contact is stamped where
+        least ``forgive_free_frames`` frames and that its evidence alone calls free. A contact is stamped where
         the robot guessed it (straight ahead); a graze of a door post puts it in the doorway,
         where it closes the door for good. A planner that finds nothing reachable may try
         without them; the next contact there marks the cell again."""
@@ -135,7 +135,7 @@ class OnlineMap:
         out[self._forced_free] = FREE
         forced = self._forced_occ
         if forgive_contacts:
-            forced = forced & ~((self._free >= cfg.forgive_free_frames) & (self._occ == 0))
+            forced = forced & ~((self._free >= cfg.forgive_free_frames) & ~occ)
         out[forced] = OCCUPIED
         return out
 

@@ -55,6 +55,7 @@ class SearchConfig:
     batch_views: int = 4  # views between two questions to the retriever
     second_look_prior: float = 0.9  # of a seen object of the requested kind the request did not fit
     second_look_m: float = 1.5  # m from it to look again from
+    place_reach: float = 1.0  # m: a place to look from that cannot be stood on is looked from this close
     old_place_prior: float = 0.6  # of the place of a saved answer seen gone from afar (never looked around at)
     distance_scale: float = 4.0  # m: a place's prior is divided by 1 + path / this
     frontier_prior: float = 0.25  # prior of unseen space beyond a frontier of ``frontier_cells`` or more
@@ -239,6 +240,11 @@ class ObjectSearch:
                 st = Status.ARRIVED if st is Status.BLOCKED and math.dist(ex.xy, p.xy) < 2 * cfg.second_look_m else st
             else:
                 st = ex.drive_to(p.xy, self._stop, planner=lvl.planner)
+                if st is Status.BLOCKED and math.dist(ex.xy, p.xy) > cfg.place_reach:
+                    # The standing point is taken now (a chair set down on it): look from a free cell near it.
+                    self._log("search", f"({p.xy[0]:.2f}, {p.xy[1]:.2f}) cannot be stood on; going to a free cell "
+                                        f"within {cfg.place_reach:.1f} m of it", ex.xy)
+                    st = ex.approach(_fixed(p.xy), cfg.place_reach, self._stop, planner=lvl.planner)
             ex.forgive_contacts = False
             visited.append(p.xy)
             self._looked_in.add(self._region_at(regions, ex.xy))
