@@ -239,3 +239,38 @@ def test_search_refuses_a_map_of_a_recording(first_map: CapNavMap, tmp_path: Pat
     msg = str(res.exception)
     assert "--search drives the simulated robot" in msg and "no simulator scene (no scene seed)" in msg
     assert "drop --search" in msg
+
+
+def _search_with(cmap: CapNavMap, world: list[Box], instruction: str, marks: list[tuple[float, float]]
+                 ):  # type: ignore[no-untyped-def]
+    """``_search`` with contact marks already on the robot's online map (grazes of earlier drives)."""
+    agent = BoxAgent(world, -1.2, -0.8, 0.0)
+    s = ObjectSearch(cmap, agent, create_detector("sim", noise="oracle", seed=0), Retriever(cmap, _EMB[0]),
+                     SearchConfig(budget_m=40.0))  # type: ignore[arg-type]
+    for xy in marks:
+        s.explorer.map.mark_obstacle(xy)
+    return agent, s.run(instruction)
+
+
+def test_a_door_closed_by_the_robots_own_contact_marks_is_tried_again(first_map: CapNavMap) -> None:
+    """Two grazes of the door posts left contact marks in the doorway, where the depth sees bare
+    floor: every place in room B looked unreachable and the search ended in room A ("no place left
+    to look from can be reached"). The search plans without those marks once nothing else is
+    reachable, and finds the lamp."""
+    world = _room_a((-0.3, 2.0))
+    agent, res = _search_with(first_map, world, "the lamp", [(0.68, -0.12), (0.68, 0.12)])
+    assert res.found, res.reason
+    assert _gap(agent, next(b for b in world if b.category == LAMP)) <= 1.0
+    assert any("contact marks on floor seen free forgiven" in s.reason for s in res.steps), res.steps
+
+
+def test_a_door_narrower_than_the_robot_and_its_margin_is_planned_through(first_map: CapNavMap) -> None:
+    """A 0.52 m door: the 0.2 m robot fits, its 0.25 m inflation (radius and margin) does not. The
+    search relaxes the inflation as CapNav's own execution does, instead of ending in room A."""
+    walls = [Box((0.6, -3.0, 0.0), (0.75, -0.26, 2.5), 0, 0, (225, 225, 215)),
+             Box((0.6, 0.26, 0.0), (0.75, 3.0, 2.5), 0, 0, (225, 225, 215))]
+    world = walls + _room_a((-0.3, 2.0))[len(WALLS):]
+    agent, res = _search_with(first_map, world, "the lamp", [])
+    assert res.found, res.reason
+    assert _gap(agent, next(b for b in world if b.category == LAMP)) <= 1.0
+    assert any("planning with inflation 0.200 m" in s.reason for s in res.steps), res.steps

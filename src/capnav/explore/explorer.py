@@ -96,6 +96,8 @@ class FrontierExplorer:
         #: Called with every frame looked at and its detections (a search maps them as it goes).
         self.on_look: Callable[[Frame, list[Any]], None] | None = None
         self._looked_from: tuple[float, float, float] | None = None  # pose of the last observation
+        #: Plan without the contact marks on cells the depth saw free (``OnlineMap.cells``): a last resort.
+        self.forgive_contacts = False
         agent_cfg = getattr(agent, "cfg", None) or getattr(agent, "config", None)
         self.turn = math.radians(float(getattr(agent_cfg, "turn_deg", 30.0)))
         self.forward = float(getattr(agent_cfg, "forward_step", 0.25))
@@ -194,7 +196,7 @@ class FrontierExplorer:
         search (inflation, cost field, A*) proportional to the explored area, not to the whole
         fixed-size online grid.
         """
-        full = self.map.grid()
+        full = self.map.grid(self.forgive_contacts)
         known = full.cells != UNKNOWN
         spec = full.spec
         rows, cols = np.nonzero(known)
@@ -336,9 +338,12 @@ class FrontierExplorer:
         return Status.BUDGET
 
     def approach(self, target: Callable[[], tuple[float, float] | None], stop_distance: float,
-                 stop: StopCheck | None = None) -> Status:
+                 stop: StopCheck | None = None, planner: PlannerConfig | None = None) -> Status:
         """Drive until within ``stop_distance`` of the (re-estimated) target, via a reachable
-        standing cell chosen by the shared planner's goal selection."""
+        standing cell chosen by the shared planner's goal selection (``planner``: another
+        inflation than the configured one, e.g. a relaxed level of ``levels.inflation_levels``)."""
+        plan_cfg = planner or self.config.planner
+
         def standing_cell() -> tuple[float, float] | None:
             t = target()
             if t is None:
@@ -347,7 +352,7 @@ class FrontierExplorer:
                 return self.xy
             grid = self.grid()
             try:
-                g = select_goal(grid, np.array([t]), self.xy, self.config.planner, self.costmap(grid))
+                g = select_goal(grid, np.array([t]), self.xy, plan_cfg, self.costmap(grid, plan_cfg))
             except CapNavError:
                 return None
             return float(g.xy[0]), float(g.xy[1])
@@ -362,7 +367,7 @@ class FrontierExplorer:
 
         if near_target(self):
             return Status.ARRIVED
-        st = self.drive_to(first, near_target, goal_of=standing_cell)
+        st = self.drive_to(first, near_target, goal_of=standing_cell, planner=plan_cfg)
         t = target()
         if t is not None and math.dist(self.xy, t) <= stop_distance:
             return Status.ARRIVED

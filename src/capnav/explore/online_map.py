@@ -43,6 +43,7 @@ class OnlineMapConfig:
     clear_below_z: float = 1.60  # rays to obstacle points lower than this clear the floor before them
     obstacle_weight: float = 4.0  # obstacle if weight * obstacle_frames >= free_frames
     robot_radius: float = 0.18  # footprint marked free where the agent stands (it cannot see it)
+    forgive_free_frames: int = 3  # a contact mark on a cell seen free this often may be forgiven (``cells``)
 
     def __post_init__(self) -> None:
         if not (self.resolution > 0 and self.half_extent > self.resolution):
@@ -118,18 +119,28 @@ class OnlineMap:
         return out
 
     # ------------------------------------------------------------------ queries
-    def cells(self) -> NDArray[np.uint8]:
-        """FREE / OCCUPIED / UNKNOWN per cell under the evidence rule of the module docstring."""
-        occ = (self._occ > 0) & (self.config.obstacle_weight * self._occ >= self._free)
+    def cells(self, forgive_contacts: bool = False) -> NDArray[np.uint8]:
+        """FREE / OCCUPIED / UNKNOWN per cell under the evidence rule of the module docstring.
+
+        ``forgive_contacts``: leave out the contact marks on cells the depth has seen free in at
+        least ``forgive_free_frames`` frames and that its evidence alone calls free. A contact is stamped where
+        the robot guessed it (straight ahead); a graze of a door post puts it in the doorway,
+        where it closes the door for good. A planner that finds nothing reachable may try
+        without them; the next contact there marks the cell again."""
+        cfg = self.config
+        occ = (self._occ > 0) & (cfg.obstacle_weight * self._occ >= self._free)
         out = np.full(self._free.shape, UNKNOWN, np.uint8) if self._prior is None else self._prior.copy()
         out[(self._free > 0) & ~occ] = FREE
         out[occ] = OCCUPIED
         out[self._forced_free] = FREE
-        out[self._forced_occ] = OCCUPIED
+        forced = self._forced_occ
+        if forgive_contacts:
+            forced = forced & ~((self._free >= cfg.forgive_free_frames) & ~occ)
+        out[forced] = OCCUPIED
         return out
 
-    def grid(self) -> OccupancyGrid:
-        return OccupancyGrid(self.spec, self.cells())
+    def grid(self, forgive_contacts: bool = False) -> OccupancyGrid:
+        return OccupancyGrid(self.spec, self.cells(forgive_contacts))
 
     def known_fraction(self) -> float:
         """The share of cells the agent's own depth has spoken for (the prior not counted)."""

@@ -30,6 +30,7 @@ import numpy as np
 from capnav.core.errors import InputError
 from capnav.core.grid import FREE
 from capnav.explore.explorer import ExplorerConfig, FrontierExplorer, Status
+from capnav.explore.levels import Level, search_levels
 from capnav.explore.live_map import LiveMap, LiveMapConfig, Snapshot
 from capnav.explore.online_map import OnlineMap, OnlineMapConfig
 from capnav.explore.places import Place, PlaceConfig, room_places
@@ -54,6 +55,7 @@ class SearchConfig:
     batch_views: int = 4  # views between two questions to the retriever
     second_look_prior: float = 0.9  # of a seen object of the requested kind the request did not fit
     second_look_m: float = 1.5  # m from it to look again from
+    place_reach: float = 1.0  # m: a place to look from that cannot be stood on is looked from this close
     old_place_prior: float = 0.6  # of the place of a saved answer seen gone from afar (never looked around at)
     distance_scale: float = 4.0  # m: a place's prior is divided by 1 + path / this
     frontier_prior: float = 0.25  # prior of unseen space beyond a frontier of ``frontier_cells`` or more
@@ -154,6 +156,7 @@ class ObjectSearch:
                                          online)
         self.live = LiveMap(cmap, detector, self.embedder, cfg.live)
         self.explorer.on_look = self.live.add
+        self._levels: list[Level] = search_levels(cfg.planner, spec.resolution)
         self.steps: list[SearchStep] = []
         self._odo0 = float(getattr(agent, "path_length", 0.0))
         self._t0 = time.monotonic()
@@ -213,32 +216,36 @@ class ObjectSearch:
             if ans.kind == "saved" and ans.obj is not None:
                 self._check_place(ans.obj)
                 continue
-            grid = ex.grid()
-            cm = ex.costmap(grid)
-            cands = [p for p in places if not self._spent(p, visited, regions)]
-            fronts = ex.frontiers(grid, cm)
-            cands += [Place(f.target_xy, -1, cfg.frontier_prior * min(1.0, f.size / cfg.frontier_cells),
-                            f"a frontier of unseen space ({f.size} cells)")
-                      for f in fronts if all(math.dist(f.target_xy, v) > ex.config.visited_radius for v in visited)]
-            cands += self._second_looks(visited)
+            cands, dist, level = self._choices(places, visited, regions)
             if not cands:
                 return self._end(f"not found: every place worth looking was looked at ({len(visited)} places, "
                                  f"{ex.looks} views) and {self._none_text(ans)}")
-            dist = self._path_lengths(grid, cm, [p.xy for p in cands])
             utility = np.array([p.prior for p in cands]) / (1.0 + dist / cfg.distance_scale)
             utility[~np.isfinite(dist)] = -1.0
             k = int(np.argmax(utility))
             if utility[k] < 0:
                 return self._end(f"not found: no place left to look from can be reached ({len(visited)} places "
-                                 f"looked from, {ex.looks} views)")
+                                 f"looked from, {ex.looks} views, also with {self._levels[-1].describe()})")
+            lvl = self._levels[level]
+            if level > 0:
+                self._log("search", f"nothing to look from is reachable with {self._levels[0].describe()} (a gap "
+                                    f"narrower than the robot and its margin, or closed by a contact mark); "
+                                    f"planning with {lvl.describe()}", ex.xy)
             p = cands[k]
             self._log("search", f"go to ({p.xy[0]:.2f}, {p.xy[1]:.2f}), {dist[k]:.1f} m away: {p.why}, prior "
                                 f"{p.prior:.2f}, best of {len(cands)} places", p.xy)
+            ex.forgive_contacts = lvl.forgive_contacts
             if p.region == SECOND_LOOK:  # the object itself stands there: look at it from a step back
-                st = ex.approach(_fixed(p.xy), cfg.second_look_m, self._stop)
+                st = ex.approach(_fixed(p.xy), cfg.second_look_m, self._stop, planner=lvl.planner)
                 st = Status.ARRIVED if st is Status.BLOCKED and math.dist(ex.xy, p.xy) < 2 * cfg.second_look_m else st
             else:
-                st = ex.drive_to(p.xy, self._stop)
+                st = ex.drive_to(p.xy, self._stop, planner=lvl.planner)
+                if st is Status.BLOCKED and math.dist(ex.xy, p.xy) > cfg.place_reach:
+                    # The standing point is taken now (a chair set down on it): look from a free cell near it.
+                    self._log("search", f"({p.xy[0]:.2f}, {p.xy[1]:.2f}) cannot be stood on; going to a free cell "
+                                        f"within {cfg.place_reach:.1f} m of it", ex.xy)
+                    st = ex.approach(_fixed(p.xy), cfg.place_reach, self._stop, planner=lvl.planner)
+            ex.forgive_contacts = False
             visited.append(p.xy)
             self._looked_in.add(self._region_at(regions, ex.xy))
             if st is Status.BLOCKED:
@@ -247,6 +254,32 @@ class ObjectSearch:
                 self._log("look", "looking around", ex.xy)
                 ex.look_around(self._stop)
         return self._out_of_budget()
+
+    def _choices(self, places: Sequence[Place], visited: Sequence[tuple[float, float]],
+                 regions: np.ndarray) -> tuple[list[Place], np.ndarray, int]:
+        """Places worth looking from, their path lengths, and the level planned with: the strictest
+        of ``levels.search_levels`` from which any of them can be reached (a relaxed level may also
+        open frontiers beyond a narrow gap)."""
+        cfg, ex = self.config, self.explorer
+        first: tuple[list[Place], np.ndarray, int] | None = None
+        for level, lvl in enumerate(self._levels):
+            ex.forgive_contacts = lvl.forgive_contacts
+            grid = ex.grid()
+            ex.forgive_contacts = False
+            cm = ex.costmap(grid, lvl.planner)
+            cands = [p for p in places if not self._spent(p, visited, regions)]
+            fronts = ex.frontiers(grid, cm)
+            cands += [Place(f.target_xy, -1, cfg.frontier_prior * min(1.0, f.size / cfg.frontier_cells),
+                            f"a frontier of unseen space ({f.size} cells)")
+                      for f in fronts if all(math.dist(f.target_xy, v) > ex.config.visited_radius for v in visited)]
+            cands += self._second_looks(visited)
+            dist = self._path_lengths(grid, cm, [p.xy for p in cands]) if cands else np.zeros(0)
+            if np.isfinite(dist).any():
+                return cands, dist, level
+            if first is None or (cands and not first[0]):
+                first = (cands, dist, level)
+        assert first is not None
+        return first
 
     def _second_looks(self, visited: Sequence[tuple[float, float]]) -> list[Place]:
         """Objects of the requested kind the robot saw that the retriever did not take: a first
@@ -448,6 +481,15 @@ class ObjectSearch:
             return self._budget_only(e) or not self._ask().same(ans)
 
         st = ex.approach(refreshed_target, cfg.stop_distance, stop)
+        for lvl in self._levels[1:]:
+            if st is not Status.BLOCKED:
+                break
+            d = math.dist(ex.xy, target())
+            self._log("search", f"no standing cell nearer than {d:.2f} m with {self._levels[0].describe()}; "
+                                f"approaching with {lvl.describe()}", ex.xy)
+            ex.forgive_contacts = lvl.forgive_contacts
+            st = ex.approach(refreshed_target, cfg.stop_distance, stop, planner=lvl.planner)
+            ex.forgive_contacts = False
         if st is Status.STOPPED and not self._timed_out:
             return None
         goal_xy = target()
