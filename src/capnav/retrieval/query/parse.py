@@ -70,6 +70,15 @@ _ROOM_ALONG = {"along", "down", "up"}
 #: their object is where one starts, a landmark, not the goal.
 _START_VERBS = {"start", "begin", "count"}
 _NEGATIVE = {"not", "n't", "except", "other", "than", "but", "without", "nor"}
+#: Verbs that ask the robot to go, lead or show ("could you take me to ...", "bring me to ..."):
+#: a request told as a story asks in the clause of the last of them, and the story around it
+#: ("we watched a film on the sofa, anyway, bring me to the lamp") describes nothing wanted.
+_REQUEST_VERBS = {"take", "bring", "guide", "lead", "escort", "show", "go", "head", "walk", "drive", "navigate",
+                  "move", "get", "find", "locate", "direct", "steer", "return"}
+#: Pronouns by which an ask points back at an object of the story before it.
+_BACK_REFERENCES = {"it", "them", "that", "this", "those", "these", "one"}
+#: Clauses hung on the request verb that tell the story before it (not the ask's own phrases).
+_STORY_DEPS = {"ccomp", "advcl", "conj", "parataxis", "csubj"}
 _SIDES = {"left": "left", "right": "right", "left-hand": "left", "right-hand": "right", "lefthand": "left",
           "righthand": "right"}
 
@@ -358,17 +367,81 @@ def _governor(t: Token) -> str:
     return t.dep_
 
 
+def _tells(clause: Token) -> bool:
+    """Whether the clause of verb ``clause`` tells something (has a subject other than the robot:
+    "I dropped a glass", "my jumper is on the bed") rather than instructs ("start at the telly and
+    go ...", whose verbs have no subject or "you")."""
+    return any(c.dep_ in ("nsubj", "nsubjpass", "expl") and c.lower_ != "you" for c in clause.children)
+
+
+def _room_phrases(doc: Doc, rooms: list[tuple[int, int, str]]) -> set[int]:
+    """The tokens of each room's phrase ("in the bedroom"): what a story keeps for its ask."""
+    out: set[int] = set()
+    for s, e, _ in rooms:
+        rh = _span_head(doc, s, e)
+        out |= {t.i for t in rh.head.subtree} if rh.dep_ == "pobj" else set(range(s, e))
+    return out
+
+
+def _back_references(doc: Doc, ask: set[int], mentions: list[tuple[int, int, str]]) -> dict[int, str]:
+    """Pronouns of the ask that point back at the story ("... on the sofa, take me to the lamp
+    next to it") -> the story's last object named before the ask, which they stand for."""
+    story = [m for m in mentions if m[0] not in ask and m[0] < min(ask)]
+    if not story:
+        return {}
+    s, e, _ = story[-1]
+    return {i: "the " + doc[s:e].text for i in sorted(ask)
+            if doc[i].lower_ in _BACK_REFERENCES and doc[i].pos_ == "PRON" and doc[i].dep_ == "pobj"}
+
+
+def _request_clause(doc: Doc, mentions: list[tuple[int, int, str]]) -> set[int] | None:
+    """The tokens of the clause that asks: the subtree of the last request verb that names an
+    object, without the telling clauses hung on it before it ("my jumper is on the bed, so bring
+    me to the wardrobe": the parser makes the story a complement of "bring"). Only when what lies
+    outside it tells a story that names an object or an attribute. None when the whole text is
+    the ask."""
+    for v in reversed(doc):
+        if v.pos_ != "VERB" or (v.lemma_ or v.lower_).lower() not in _REQUEST_VERBS:  # an ask is in the base form
+            continue
+        ask = {t.i for t in v.subtree}
+        for c in v.children:
+            if c.dep_ in _STORY_DEPS and c.i < v.i and _tells(c):
+                ask -= {t.i for t in c.subtree}
+        if not any(m[0] in ask for m in mentions):
+            continue
+        outside = [t for t in doc if t.i not in ask]
+        tells = any(_tells(t) for t in outside if t.pos_ in ("VERB", "AUX"))
+        named = any(m[0] not in ask for m in mentions) or any(attribute_word(t.lower_) for t in outside)
+        return ask if tells and named else None
+    return None
+
+
 def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
     g = GoalParse(text, text, parser=parser)
     mentions = _mentions(doc)
+    ask = _request_clause(doc, mentions)
+    refs: dict[int, str] = {}
+    if ask is not None:
+        refs = _back_references(doc, ask, mentions)
+        mentions = [m for m in mentions if m[0] in ask]
+        g.notes.append("read the request's own clause: " + doc[min(ask):max(ask) + 1].text)
+    # A story's room is where it happens ("... in the kitchen, so take me to the plant in there").
     rooms = _room_mentions(doc)
     room_tokens = {i for s, e, _ in rooms for i in range(s, e)}
-    mentions = [m for m in mentions if not room_tokens.intersection(range(m[0], m[1]))]
+    # A room word that names the object with it ("the kitchen counter", a form of the counter)
+    # is the object's name; a mention that ends in a room word ("the study" read as a desk's
+    # form) is the room.
+    mentions = [m for m in mentions if m[1] - 1 not in room_tokens]
+    in_names = {i for s, e, _ in mentions for i in range(s, e)}
+    rooms = [r for r in rooms if not in_names.intersection(range(r[0], r[1]))]
+    room_tokens = {i for s, e, _ in rooms for i in range(s, e)}
     cands: list[tuple[tuple[int, int, int, int], int, int, str | None]] = []
     for s, e, cat in mentions:
         h = _span_head(doc, s, e)
         cands.append(((int(_is_landmark(h)), _depth(h), 0, s), s, e, cat))
     for t in doc:
+        if ask is not None and t.i not in ask:
+            continue
         if t.text.lower() in _GENERIC and t.pos_ in ("NOUN", "PRON") and not any(s <= t.i < e for _, s, e, _ in cands):
             cands.append(((int(_is_landmark(t)), _depth(t), 1, t.i), t.i, t.i + 1, None))
     for t in doc:
@@ -395,11 +468,13 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
     key, s, e, _cat = cands[0]
     if key[0]:
         # Every object named is a landmark of something unnamed ("what is next to the fridge"):
-        # the whole goal goes to the mapping.
+        # the whole goal (its ask, after a story) goes to the mapping.
+        if ask is not None:
+            g.core = _words(doc, set(ask) | _room_phrases(doc, rooms), rooms, refs)
         return g
     head = _span_head(doc, s, e)
     g.head = doc[s:e].text
-    keep = {t.i for t in doc}
+    keep = {t.i for t in doc} if ask is None else set(ask) | _room_phrases(doc, rooms)
     named = {i for m in mentions for i in range(m[0], m[1])} | room_tokens
     # Up the tree from the head: a phrase or clause hanging on the way that names no object or
     # room but carries an attribute word ("every blue moon", "when I feel blue", "nip round")
@@ -447,7 +522,7 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
         if t.i in keep and t.i not in own and t.i not in others and attribute_word(t.lower_) \
                 and not _describes_target(t, head):
             keep -= _word_of(doc, t)
-    g.core = _words(doc, keep, rooms)
+    g.core = _words(doc, keep, rooms, refs)
     g.dropped = [t.text for t in doc if t.i not in keep and not t.is_punct and not t.is_stop]
     g.modifiers = [t.text for t in head.children if t.dep_ in ("amod", "compound", "nmod", "nummod", "acomp")
                    and not s <= t.i < e]
@@ -523,9 +598,10 @@ def _describes_target(t: Token, head: Token) -> bool:
     return False
 
 
-def _words(doc: Doc, keep: set[int], rooms: list[tuple[int, int, str]]) -> str:
+def _words(doc: Doc, keep: set[int], rooms: list[tuple[int, int, str]], refs: dict[int, str] | None = None) -> str:
     """The kept words in their order, a space wherever a word was left out; a destination room
-    ("into the lounge") reads as where the target stands ("in the lounge")."""
+    ("into the lounge") reads as where the target stands ("in the lounge"); a pronoun of ``refs``
+    as the object it stands for."""
     out: list[str] = []
     dest = set()
     for s, e, _ in rooms:
@@ -535,7 +611,7 @@ def _words(doc: Doc, keep: set[int], rooms: list[tuple[int, int, str]]) -> str:
     for t in doc:
         if t.i not in keep:
             continue
-        w = "in" if t.i in dest else " not" if t.lower_ == "n't" else t.text
+        w = "in" if t.i in dest else " not" if t.lower_ == "n't" else (refs or {}).get(t.i, t.text)
         out.append(w + (t.whitespace_ if t.i + 1 in keep else " "))
     return "".join(out).strip(" ,;:-") or doc.text
 
