@@ -483,9 +483,10 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
     while node.head.i != node.i and len(on_path) < 64:
         node = node.head
         on_path.add(node.i)
+    own = {t.i for t in head.subtree} | _right_attached(doc, head, on_path)
     for i in sorted(on_path):
         for c in doc[i].children:
-            if c.i in on_path:
+            if c.i in on_path or c.i in own:
                 continue
             if i == head.i:
                 continue  # the head's own words
@@ -516,7 +517,6 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
             keep -= {t.i}  # "right next to the bed": an intensifier, no side and no attribute
     # An attribute word the parse does not attach to the head, to a landmark or to a stand-in for
     # the target ("the white one") is not the target's: "when I am green with envy".
-    own = {t.i for t in head.subtree}
     others = {t.i for m in mentions if m[0] != s for t in _span_head(doc, m[0], m[1]).subtree}
     for t in doc:
         if t.i in keep and t.i not in own and t.i not in others and attribute_word(t.lower_) \
@@ -531,6 +531,29 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
                 and any(m[0] <= t.i < m[1] for m in mentions):
             g.landmarks.append((t.head.text.lower(), doc[t.left_edge.i:t.i + 1].text))
     return g
+
+
+def _right_attached(doc: Doc, head: Token, on_path: set[int]) -> set[int]:
+    """The prepositional phrases right after the target's phrase that the parser hung on a verb
+    above it, read as the target's own ("go to the plant in the white pot", "navigate to the lamp
+    with the green shade"): a phrase that follows a noun modifies that noun unless its preposition
+    says where the motion goes, comes from or passes, what it is for or when (right association).
+    A phrase that opens a clause or comes after a comma stays where the parser put it."""
+    out: set[int] = set()
+    end = head.right_edge.i
+    while True:
+        nxt = next((c for i in sorted(on_path - {head.i}) for c in doc[i].children
+                    if c.dep_ == "prep" and c.i not in on_path and c.left_edge.i == end + 1), None)
+        if nxt is None or nxt.lower_ in _VERB_PREPS or not any(k.dep_ == "pobj" for k in nxt.children):
+            return out
+        out |= {t.i for t in nxt.subtree}
+        end = nxt.right_edge.i
+
+
+#: Prepositions of the motion itself (its goal, source, path), its purpose or time: a phrase
+#: they open after the target's noun stays on the verb ("go to the sofa for a green tea").
+_VERB_PREPS = {"to", "towards", "toward", "into", "onto", "from", "through", "past", "via", "for", "after",
+               "before", "until", "till", "during", "since", "then"}
 
 
 #: Dependencies that start a clause of their own under a noun: not part of that noun's phrase.
