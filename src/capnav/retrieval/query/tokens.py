@@ -135,7 +135,10 @@ _SHAPES = {"round": "round", "circular": "round", "l-shaped": "L-shaped", "l sha
 _GROWTH = _LEX.growth
 _GROWTH_TOKENS = {w for f in _GROWTH for w in f.split()}
 _RELATIONS = [END_OF, "in front of", "facing", "next to", "close to", "beside", "besides", "near", "by", "behind",
-              "opposite", "across from", "alongside", "against"]
+              "opposite", "across from", "alongside", "against",
+              # above or below the landmark: on the floor plan the two touch (ranked by the gap
+              # between footprints, as "next to"); the thing hung over a sink is not the sink
+              "on top of", "above", "below", "underneath", "beneath", "under", "atop"]
 _MATERIALS = {"wooden", "wood", "leather", "fabric", "velvet", "metal", "glass", "marble", "plastic",
               "ceramic", "stainless", "steel", "laminate", "cotton", "acrylic", "paper", "terracotta", "chrome"}
 #: Every other material word WordNet has, spoken as the material the surface test knows

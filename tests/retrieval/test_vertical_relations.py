@@ -1,0 +1,52 @@
+"""Above, below, under, on top of: a relation to a landmark, not the landmark. "The mirror above
+the sink" asks for a mirror (the map has none: not found), never for the sink it hangs over; "the
+lamp above the desk" is the lamp whose footprint touches the desk's. Sentences and scene written
+for these tests, none from the development phrasings."""
+
+from __future__ import annotations
+
+import pytest
+
+from capnav.retrieval import Retriever
+from capnav.retrieval.query import parse_instruction
+from language.synth import grid_with_wall, make_obj, offline_retriever
+
+
+@pytest.fixture(scope="module")
+def retriever() -> Retriever:
+    objs = [
+        make_obj(1, "sink", (1.0, 1.0), (0.6, 0.5, 0.9), (240, 240, 240)),
+        make_obj(2, "desk", (2.5, 5.5), (1.2, 0.6, 0.75), (120, 80, 50)),
+        make_obj(3, "lamp", (2.9, 5.6), (0.3, 0.3, 0.5), (30, 30, 30)),  # stands on the desk
+        make_obj(4, "lamp", (0.5, 3.0), (0.4, 0.4, 1.5), (30, 30, 30)),
+        make_obj(5, "counter", (7.0, 1.0), (2.0, 0.6, 0.9), (200, 200, 200)),
+        make_obj(6, "stool", (7.2, 1.5), (0.4, 0.4, 0.6), (90, 90, 90)),  # tucked under the counter
+        make_obj(7, "stool", (6.5, 5.0), (0.4, 0.4, 0.6), (90, 90, 90)),
+    ]
+    return offline_retriever(objs, grid_with_wall(-1, -1, 9, 7, wall_x=4.0, door=(2.5, 3.5)))
+
+
+@pytest.mark.parametrize(("text", "relation", "anchor"), [
+    ("take me to the mirror hanging above the sink", "above", "sink"),
+    ("the picture on top of the dresser", "on top of", "dresser"),
+    ("go to the rug underneath the coffee table", "underneath", "coffee table"),
+])
+def test_the_landmark_is_not_the_target(text: str, relation: str, anchor: str) -> None:
+    q = parse_instruction(text)
+    assert q.category is None and q.relation == relation and q.anchor_category == anchor, q
+
+
+@pytest.mark.parametrize("text", ["take me to the mirror hanging above the sink", "the mirror above the sink"])
+def test_an_absent_thing_over_a_landmark_is_not_found(retriever: Retriever, text: str) -> None:
+    res = retriever.query(text)
+    assert not res.found, res.reason
+
+
+@pytest.mark.parametrize(("text", "oid"), [
+    ("the lamp on top of the desk", 3),
+    ("could you go to the stool under the counter", 6),
+    ("the stool beneath the counter", 6),
+])
+def test_a_thing_above_or_below_a_landmark_is_the_one_touching_it(retriever: Retriever, text: str, oid: int) -> None:
+    res = retriever.query(text)
+    assert res.found and res.chosen is not None and res.chosen.id == oid, res.reason
