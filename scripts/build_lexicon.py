@@ -57,6 +57,13 @@ is spoken to):
   another sense first) and which are not used more often as a noun or verb in WordNet's
   sense-tagged corpus ("minute", "giant"), with their comparatives from WordNet's exception list
   (``adj.exc``: bigger, tinier); a hyphenated one also with a space ("king size").
+- ``heights`` / ``height_superlatives``: words of height -> "large" / "small" ("tall", "short",
+  "lanky", "stumpy", "lower") and "tallest", "shortest", "highest", "lowest" -> "largest" /
+  "smallest": the head of WordNet's adjective of stature (``tall.a.01``) and of elevation
+  (``high.a.02``), each with its antonym (short, low) and their regular -er / -est forms, plus the
+  stature clusters' lemmas chosen as the size words are (not the elevation cluster's: it holds
+  "under" and "upper"); a word the size table has ("little") stays a size. The retriever compares
+  these against the mapped heights, not the volumes.
 - ``growth``: words that name a plant's growth form -> the growth word the captioner measures
   from the points (``capnav.language.form.growth``). A cactus grows as a column narrower than its
   pot, so every lemma of ``cactus.n.01`` and its hyponyms, and of ``succulent.n.01`` itself (the
@@ -191,6 +198,7 @@ def build(wordnet: Path) -> dict[str, Any]:
         wn = open_wordnet(wordnet, Path(tmp))
         out = _build(wn)
         out["sizes"] = _sizes(wn, (wordnet / "adj.exc").read_text().splitlines())
+        out["heights"], out["height_superlatives"] = _heights(wn, out["sizes"])
         out["growth"] = _growth(wn, out["forms"])
         out["labels"] = _labels(wn, out["forms"])
         out["persons"] = _persons(wn, (wordnet / "noun.exc").read_text().splitlines())
@@ -292,6 +300,46 @@ def _sizes(wn: Any, exceptions: list[str]) -> dict[str, str]:
         if not infl.endswith("est") and any(b in out for b in bases):
             out.setdefault(infl, out[next(b for b in bases if b in out)])
     return dict(sorted(out.items()))
+
+
+#: Height: WordNet's adjective of stature, whose antonym gives the other end, and the head of
+#: elevation with its antonym (only the two head words: that cluster holds "under", "upper").
+HEIGHT_HEADS = {"stature": "tall.a.01", "elevation": "high.a.02"}
+
+
+def _heights(wn: Any, sizes: dict[str, str]) -> tuple[dict[str, str], dict[str, str]]:
+    """Height adjectives -> "large" / "small" and superlatives -> "largest" / "smallest" (see the
+    module docstring): the head words of stature and elevation and their antonyms (tall, short,
+    high, low) with their regular comparatives and superlatives ("taller", "lowest"), and the
+    lemmas of the stature clusters whose most frequent adjective sense lies in them ("lanky",
+    "stumpy"), as the size words are chosen; a word of the size table ("little") stays a size."""
+
+    def count(lemma: str, pos: str) -> int:
+        return sum(lem.count() for s in wn.synsets(lemma, pos) for lem in s.lemmas() if lem.name() == lemma)
+
+    words: dict[str, str] = {}
+    superlative: dict[str, str] = {}
+    for dim, head in HEIGHT_HEADS.items():
+        up = wn.synset(head)
+        down = next(a.synset() for lem in up.lemmas() for a in lem.antonyms())
+        for size, syn in (("large", up), ("small", down)):
+            word = syn.lemmas()[0].name()  # the head word: regular -er / -est
+            words[word] = words[word + "er"] = size
+            superlative[word + "est"] = {"large": "largest", "small": "smallest"}[size]
+            if dim != "stature":
+                continue
+            cluster = {syn, *syn.similar_tos()}
+            for lemma in sorted({lem.name() for c in cluster for lem in c.lemmas()}):
+                if lemma != lemma.lower() or "_" in lemma or lemma in words or lemma in sizes:
+                    continue
+                senses = [s for s in wn.synsets(lemma) if s.pos() in "as"
+                          and any(lem.name() == lemma for lem in s.lemmas())]
+                if not senses or senses[0] not in cluster:
+                    continue
+                if max(count(lemma, "n"), count(lemma, "v")) > count(lemma, "a"):
+                    continue
+                words[lemma] = size
+    return dict(sorted(words.items())), dict(sorted(superlative.items()))
 
 
 #: Growth forms: the synset whose lemmas (with its hyponyms') imply the growth word, the synsets

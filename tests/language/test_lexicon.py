@@ -85,6 +85,18 @@ def test_size_adjectives_come_from_wordnet_s_size_clusters():
         assert w not in sizes, w
 
 
+def test_height_words_come_from_wordnet_s_adjectives_of_stature_and_elevation():
+    lex = load_lexicon()
+    for w in ("tall", "taller", "high", "higher", "lanky"):
+        assert lex.heights[w] == "large", w
+    for w in ("short", "shorter", "low", "lower", "stumpy"):
+        assert lex.heights[w] == "small", w
+    assert lex.height_superlatives == {"tallest": "largest", "highest": "largest", "shortest": "smallest",
+                                       "lowest": "smallest"}
+    # the elevation cluster's other lemmas are not heights of furniture; a size word stays a size
+    assert "under" not in lex.heights and "upper" not in lex.heights and "little" not in lex.heights
+
+
 def test_cactus_words_imply_the_columnar_growth_form():
     lex = load_lexicon()
     # cacti and their hyponyms, the succulent itself, and the adjectives of the cactus's spines

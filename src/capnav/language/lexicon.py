@@ -56,6 +56,10 @@ class Lexicon:
     #: a material word -> the material the surface test knows ("velvety" velvet, "suede" leather,
     #: "teak" wood, "chenille" fabric, "brass" metal; WordNet's, see build_lexicon)
     materials: dict[str, str] = field(default_factory=dict)
+    #: a height word ("tall", "stumpy", "lower") -> "large" / "small"; "tallest", "lowest" ->
+    #: "largest" / "smallest" (WordNet's, see build_lexicon): compared with the mapped heights
+    heights: dict[str, str] = field(default_factory=dict)
+    height_superlatives: dict[str, str] = field(default_factory=dict)
     load_seconds: float = 0.0
 
     def category_alternatives(self, category: str, form: str | None = None) -> dict[str, float]:
@@ -93,7 +97,8 @@ def load_lexicon() -> Lexicon:
                   persons=frozenset(raw.get("persons", [])),
                   kinds={k: tuple(v) for k, v in raw.get("kinds", {}).items()},
                   placing=frozenset(raw.get("placing", [])), body=frozenset(raw.get("body", [])),
-                  materials=dict(raw.get("materials", {})))
+                  materials=dict(raw.get("materials", {})), heights=dict(raw.get("heights", {})),
+                  height_superlatives=dict(raw.get("height_superlatives", {})))
     object.__setattr__(lex, "load_seconds", time.perf_counter() - t0)
     return lex
 

@@ -318,14 +318,19 @@ class OfflineVerifier(Verifier):
 
     def size(self, q: ParsedQuery, obj: MapObject) -> float:
         """1 when the object is the size the query says among its category, 0 when the opposite,
-        0.5 when the category's mapped volumes are too close to tell (``size_ratio``)."""
+        0.5 when the category's mapped volumes are too close to tell (``size_ratio``). A word of
+        height ("the tall lamp") is judged on the mapped heights, at the same linear tolerance
+        (the cube root of the volume ratio)."""
         if q.size_word is None or self.scene is None or obj.id not in self.scene.index:
             return 0.0
         peers = [self.scene.index[o.id] for o in self.scene.same_label(obj)]
-        vols = np.sort(self.scene.volume[peers])
-        if len(vols) < 2 or vols[-1] < self.config.size_ratio * vols[0]:
+        height = q.size_axis == "height"
+        measure = self.scene.height if height else self.scene.volume
+        ratio = self.config.size_ratio ** (1.0 / 3.0) if height else self.config.size_ratio
+        vols = np.sort(measure[peers])
+        if len(vols) < 2 or vols[-1] < ratio * vols[0]:
             return 0.5
-        v = float(self.scene.volume[self.scene.index[obj.id]])
+        v = float(measure[self.scene.index[obj.id]])
         frac = float(np.log(v / vols[0]) / np.log(vols[-1] / vols[0]))  # 0 smallest .. 1 largest
         return frac if q.size_word == "large" else 1.0 - frac
 

@@ -1,4 +1,5 @@
-"""A superlative of size ("the biggest armchair"): the mapped volume orders the candidates."""
+"""A superlative of size ("the biggest armchair"): the mapped volume orders the candidates; of
+height ("the tallest lamp", "the lowest table"), the mapped height."""
 
 from __future__ import annotations
 
@@ -18,7 +19,10 @@ class Superlative(RankingConstraint):
     def rank(self, st: RankState) -> None:
         if not st.r.config.use_predicates:
             return
-        vol = st.r.volume[st.pool]
+        if st.q.size_axis == "height":
+            vol, what = st.r.scene.height[st.pool], "height (m)"
+        else:
+            vol, what = st.r.volume[st.pool], "volume (m3)"
         st.group_keys.append(-vol if st.q.superlative == "largest" else vol)
-        st.values["volume (m3)"] = vol
+        st.values[what] = vol
         st.predicate, st.mode = st.q.superlative, "predicate"

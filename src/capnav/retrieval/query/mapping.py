@@ -39,6 +39,7 @@ from capnav.retrieval.query.tokens import (
     _room_before,
     _size_word,
     materials_in,
+    size_axis,
     validate_instruction,
 )
 
@@ -291,7 +292,7 @@ def _attributes_outside(q: ParsedQuery, head: str, activity: str) -> None:
     q.colors = _colors(words)
     q.shapes = list(dict.fromkeys(_SHAPES[w] for w in words if w in _SHAPES))
     q.materials = materials_in(words)
-    q.size_word = _size_word(words)
+    q.size_word, q.size_axis = _size_word(words)
 
 
 def _count(q: ParsedQuery, head: str) -> str:
@@ -396,9 +397,12 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     words = [w for w in re.split(r"\s+", head.strip()) if w]
     for phrase in sorted(_SUPERLATIVE, key=len, reverse=True):
         if phrase in head and re.search(rf"\b{phrase}\b", head):
-            q.superlative = _SUPERLATIVE[phrase]
+            q.superlative, q.size_axis = _SUPERLATIVE[phrase], size_axis(phrase)
             break
-    q.size_word = _size_word(words)
+    if q.superlative is None:
+        q.size_word, q.size_axis = _size_word(words)
+    else:
+        q.size_word = _size_word(words)[0]
     q.colors = _colors(words)
     if len(q.colors) > 1 and "terracotta" in q.colors:  # "a yellow terracotta pot": a material here
         q.colors.remove("terracotta")

@@ -23,6 +23,7 @@ class ParsedQuery:
     shapes: list[str] = field(default_factory=list)
     size_word: str | None = None  # "large" / "small"
     superlative: str | None = None  # "largest" / "smallest"
+    size_axis: str | None = None  # what the size word or superlative measures: "height" ("tall"), None: volume
     proximity: str | None = None  # "closest" / "farthest"
     relation: str | None = None  # "next to", ...
     anchor_category: str | None = None

@@ -117,12 +117,17 @@ _MULTI_TYPO_SCORE = 86.0
 _PROXIMITY = {"closest": "closest", "nearest": "closest", "near me": "closest", "closest to me": "closest",
               "farthest": "farthest", "furthest": "farthest", "most distant": "farthest"}
 _SUPERLATIVE = {"biggest": "largest", "largest": "largest", "largest one": "largest", "widest": "largest",
-                "tallest": "largest", "smallest": "smallest", "tiniest": "smallest", "littlest": "smallest",
-                "narrowest": "smallest"}
+                "smallest": "smallest", "tiniest": "smallest", "littlest": "smallest", "narrowest": "smallest"}
+#: "tallest", "lowest" (the lexicon's ``height_superlatives``): ordered by the mapped height.
+_SUPERLATIVE.update(_LEX.height_superlatives)
 _SIZE_WORDS = {"big": "large", "large": "large", "huge": "large", "larger": "large", "bigger": "large",
                "small": "small", "little": "small", "tiny": "small", "smaller": "small", "compact": "small"}
 #: WordNet's size adjectives and their comparatives ("king-size", "oversized", "tinier"; the lexicon).
 _SIZE_WORDS.update(_LEX.sizes)
+#: Words of height ("tall", "short", "lanky", "lower"; the lexicon's ``heights``): compared with
+#: the mapped heights of the category rather than the volumes. A size word of both tables stays a size.
+_SIZE_WORDS.update({w: s for w, s in _LEX.heights.items() if w not in _SIZE_WORDS})
+_HEIGHT_WORDS = {w for w in _LEX.heights if w not in _LEX.sizes} | set(_LEX.height_superlatives)
 _SIZE_TOKENS = {w for f in _SIZE_WORDS for w in f.split()}
 _SHAPES = {"round": "round", "circular": "round", "l-shaped": "L-shaped", "l shaped": "L-shaped",
            "corner": "L-shaped", "long": "long", "rectangular": "rectangular", "square": "square",
@@ -377,17 +382,23 @@ def _room_before(words: list[str], start: int) -> tuple[str | None, int]:
     return None, start
 
 
-def _size_word(words: list[str]) -> str | None:
-    """"large" / "small" from the first size word ("king size" and "king-size" alike); a size word
-    right after "a" / "an" that ends the sentence is a noun ("I need a wee", "move a little")."""
+def _size_word(words: list[str]) -> tuple[str | None, str | None]:
+    """"large" / "small" from the first size word ("king size" and "king-size" alike), with what it
+    measures (``size_axis``); a size word right after "a" / "an" that ends the sentence is a noun
+    ("I need a wee", "move a little")."""
     for i in range(len(words)):
         for n in (2, 1):
             gram = " ".join(words[i:i + n])
             if i + n <= len(words) and gram in _SIZE_WORDS:
                 if i + n == len(words) and i > 0 and words[i - 1] in ("a", "an"):
                     continue
-                return _SIZE_WORDS[gram]
-    return None
+                return _SIZE_WORDS[gram], size_axis(gram)
+    return None, None
+
+
+def size_axis(word: str) -> str | None:
+    """What a size word or superlative measures: "height" ("tall", "lowest"), or None for the volume."""
+    return "height" if word in _HEIGHT_WORDS else None
 
 
 def _other_object(words: list[str], span: tuple[int, int] | None) -> str | None:
