@@ -26,9 +26,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
-from capnav.core.errors import InputError
-from capnav.core.grid import FREE
+from capnav.core.errors import CapNavError, InputError
+from capnav.core.grid import FREE, OccupancyGrid
 from capnav.explore.explorer import ExplorerConfig, FrontierExplorer, Status
 from capnav.explore.levels import Level, search_levels
 from capnav.explore.live_map import LiveMap, LiveMapConfig, Snapshot
@@ -36,7 +37,8 @@ from capnav.explore.online_map import OnlineMap, OnlineMapConfig
 from capnav.explore.places import Place, PlaceConfig, room_places
 from capnav.language.embedder import TextEmbedder
 from capnav.mapping.cmap import CapNavMap, MapObject
-from capnav.planning import PlannerConfig
+from capnav.planning import Costmap, PlannerConfig
+from capnav.planning.costmap import locate_start
 from capnav.planning.search import cost_field
 from capnav.retrieval.query import ParsedQuery, parse_goals
 from capnav.retrieval.result import QueryResult
@@ -273,7 +275,8 @@ class ObjectSearch:
                             f"a frontier of unseen space ({f.size} cells)")
                       for f in fronts if all(math.dist(f.target_xy, v) > ex.config.visited_radius for v in visited)]
             cands += self._second_looks(visited)
-            dist = self._path_lengths(grid, cm, [p.xy for p in cands]) if cands else np.zeros(0)
+            reach = [cfg.second_look_m if p.region == SECOND_LOOK else cfg.place_reach for p in cands]
+            dist = path_lengths(grid, cm, ex.xy, [p.xy for p in cands], lvl.planner, reach) if cands else np.zeros(0)
             if np.isfinite(dist).any():
                 return cands, dist, level
             if first is None or (cands and not first[0]):
@@ -408,29 +411,6 @@ class ObjectSearch:
         frac = float(seen.mean())
         return frac >= self.config.seen_anyway or (p.region in self._looked_in and frac >= self.config.seen_fraction)
 
-    def _path_lengths(self, grid: Any, cm: Any, targets: list[tuple[float, float]]) -> np.ndarray:
-        passable = np.isfinite(cm.weights)
-        rc0 = grid.spec.to_cell(np.asarray(self.explorer.xy))
-        start = (int(np.clip(rc0[0], 0, grid.spec.rows - 1)), int(np.clip(rc0[1], 0, grid.spec.cols - 1)))
-        if not passable[start]:
-            near = np.argwhere(passable)
-            if len(near):
-                j = int(np.argmin(((near - np.asarray(start)) ** 2).sum(1)))
-                start = (int(near[j, 0]), int(near[j, 1]))
-        fld, _ = cost_field(cm.weights, start)
-        out = np.full(len(targets), np.inf)
-        rc = grid.spec.to_cell(np.asarray(targets, dtype=np.float64).reshape(-1, 2))
-        ok = grid.spec.inside(rc)
-        out[ok] = fld[rc[ok, 0], rc[ok, 1]] * grid.spec.resolution
-        # A target on an obstacle (an object to look at again): the walk to the nearest cell within a metre.
-        k = round(1.0 / grid.spec.resolution)
-        for i in np.flatnonzero(ok & ~np.isfinite(out)):
-            r, c = int(rc[i, 0]), int(rc[i, 1])
-            win = fld[max(r - k, 0):r + k + 1, max(c - k, 0):c + k + 1]
-            if np.isfinite(win).any():
-                out[i] = float(np.nanmin(np.where(np.isfinite(win), win, np.nan))) * grid.spec.resolution + 1.0
-        return out
-
     # ------------------------------------------------------------------ going to the answer
     def _stop(self, ex: FrontierExplorer) -> bool:
         """Stop a drive or a look-around when a batch of views changed the answer."""
@@ -539,6 +519,52 @@ class ObjectSearch:
         return SearchResult(found, reason, target, self.driven(), self.steps, self.explorer.looks, from_map,
                             self._found_id if found and from_map else None, self.asks)
 
+
+
+def path_lengths(grid: OccupancyGrid, cm: Costmap, start_xy: tuple[float, float],
+                 targets: Sequence[tuple[float, float]], planner: PlannerConfig,
+                 reach: Sequence[float] | float = 0.0) -> NDArray[np.float64]:
+    """Metres of the drive from ``start_xy`` to each target, as the drive would plan it: the start
+    snapped to a passable cell as ``planning.locate_start`` snaps it (within the planner's escape
+    radius, else nothing is reachable: the drive would refuse to plan), a target on a passable cell
+    reached there, a blocked one (an object, a room's point on furniture) at the cheapest passable
+    cell within ``reach`` of it (the approach that stops that close), else never (inf).
+
+    Why: a start in the inflation band snapped to the nearest passable cell anywhere may land
+    behind a wall, and then places look reachable at a strict inflation that the drive refuses
+    (every drive "could not get to"), and the relaxed levels that would get the robot out are
+    never tried."""
+    n = len(targets)
+    out = np.full(n, np.inf)
+    if n == 0:
+        return out
+    try:
+        s_cell, _ = locate_start(cm, start_xy, planner)
+    except CapNavError:
+        return out
+    fld, _ = cost_field(cm.weights, s_cell)
+    spec = grid.spec
+    res = spec.resolution
+    radii = np.broadcast_to(np.asarray(reach, dtype=np.float64), (n,))
+    rc = spec.to_cell(np.asarray(targets, dtype=np.float64).reshape(-1, 2))
+    ok = spec.inside(rc)
+    out[ok] = fld[rc[ok, 0], rc[ok, 1]] * res
+    for i in np.flatnonzero(~np.isfinite(out) & (radii > 0)):
+        k = int(np.ceil(radii[i] / res))
+        r, c = int(rc[i, 0]), int(rc[i, 1])
+        r0, c0 = max(r - k, 0), max(c - k, 0)
+        r1, c1 = min(r + k + 1, spec.rows), min(c + k + 1, spec.cols)
+        if r0 >= r1 or c0 >= c1:
+            continue
+        win = fld[r0:r1, c0:c1]
+        rr, cc = np.mgrid[r0:r1, c0:c1]
+        centres = spec.to_world(np.stack([rr.ravel(), cc.ravel()], axis=1)).reshape(r1 - r0, c1 - c0, 2)
+        tx, ty = targets[int(i)]
+        near = np.hypot(centres[..., 0] - tx, centres[..., 1] - ty) <= radii[i]
+        vals = win[near & np.isfinite(win)]
+        if vals.size:
+            out[i] = float(vals.min()) * res
+    return out
 
 def search_goal(cmap: CapNavMap, retriever: Any, instruction: Any, agent: Any, detector: Any,
                 config: SearchConfig | None = None) -> tuple[Any, SearchResult]:
