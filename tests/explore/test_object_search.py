@@ -317,3 +317,22 @@ def test_path_lengths_agree_with_the_drive_planner() -> None:
             assert drivable(start, t) == bool(np.isfinite(d)), (start, t, d)
     assert np.isfinite(path_lengths(grid, cm, (0.5, 2.0), targets, cfg, reach)).sum() >= 5
     assert not np.isfinite(path_lengths(grid, cm, (1.78, 0.5), targets, cfg, reach)).any()
+
+
+def test_a_look_from_behind_a_wall_does_not_spend_a_place(first_map: CapNavMap) -> None:
+    """A place to look from in room A 1.2 m from where the robot looked around in room B, the wall
+    between them: that look saw nothing of the place (s100001: a bathroom's standing point 1.4 m
+    from the bedroom's, spent by the bedroom's look, its new plant never seen). A look from as near
+    on the place's own side of the wall does spend it."""
+    from capnav.explore.places import Place, room_places
+
+    agent = BoxAgent(_room_a((-0.3, 2.0)), -1.2, -0.8, 0.0)
+    s = ObjectSearch(first_map, agent, create_detector("sim", noise="oracle", seed=0), Retriever(first_map, _EMB[0]),
+                     SearchConfig())  # type: ignore[arg-type]
+    _, regions = room_places(first_map, "plant", _EMB[0])  # type: ignore[arg-type]
+    s._looked_in = set()
+    here = (0.1, -1.5)
+    rc = first_map.occupancy.spec.to_cell(np.asarray(here))
+    place = Place(here, int(regions[rc[0], rc[1]]), 0.5, "room A by the wall")
+    assert not s._spent(place, [(1.3, -1.5)], regions)  # room B, 1.2 m away, behind the wall
+    assert s._spent(place, [(-1.0, -1.5)], regions)  # room A, 1.1 m away, in the open

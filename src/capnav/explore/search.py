@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.core.errors import CapNavError, InputError
-from capnav.core.grid import FREE, OccupancyGrid
+from capnav.core.grid import FREE, OCCUPIED, OccupancyGrid
 from capnav.explore.explorer import ExplorerConfig, FrontierExplorer, Status
 from capnav.explore.levels import Level, search_levels
 from capnav.explore.live_map import LiveMap, LiveMapConfig, Snapshot
@@ -170,6 +170,8 @@ class ObjectSearch:
         self._snap: Snapshot | None = None
         self._found_id: int | None = None
         self._answered: dict[int, MapObject] = {}  # saved objects that were the answer at some time
+        self._spots: list[tuple[float, float]] = []  # where the robot looked around
+        self._cells_at: tuple[int, np.ndarray] | None = None  # the online map's cells, at a number of views
 
     # ------------------------------------------------------------------ the request
     def run(self, instruction: str | ParsedQuery, first: QueryResult | None = None) -> SearchResult:
@@ -208,6 +210,7 @@ class ObjectSearch:
         places, regions = room_places(self.cmap, self._parsed.category, self.embedder, cfg.places)
         visited: list[tuple[float, float]] = []
         self._looked_in: set[int] = {self._region_at(regions, ex.xy)}
+        self._spots.append(ex.xy)  # looked around where the request was heard
         while not self._over(None):
             ans = self._ask(force=True)
             if ans.kind in ("new", "confirmed") and ans.obj is not None:
@@ -254,6 +257,7 @@ class ObjectSearch:
                 self._log("search", f"could not get to ({p.xy[0]:.2f}, {p.xy[1]:.2f}); giving it up", ex.xy)
             elif not self._over(st) and st is not Status.STOPPED:
                 self._log("look", "looking around", ex.xy)
+                self._spots.append(ex.xy)
                 ex.look_around(self._stop)
         return self._out_of_budget()
 
@@ -317,6 +321,7 @@ class ObjectSearch:
         if st is Status.STOPPED or self._over(st):
             return
         self._log("look", f"at the map's place of object {o.id}: looking around", ex.xy)
+        self._spots.append(ex.xy)
         if ex.look_around(self._stop) is Status.STOPPED:
             return
         ans = self._ask(force=True)
@@ -324,6 +329,7 @@ class ObjectSearch:
             return
         if self.live.frames and o.id not in self._answer_ids("confirmed"):
             self.live.absent.add(o.id)
+            self._asked_at = -1  # ask again now, without it (not after another look around at the same place)
             self._log("search", f"not at its place: object {o.id} not seen within {cfg.at_place + 0.2:.1f} m of "
                                 f"where the map has it after {ex.looks} views; asking again without it", ex.xy)
 
@@ -392,7 +398,7 @@ class ObjectSearch:
     def _spent(self, p: Place, visited: Sequence[tuple[float, float]], regions: np.ndarray) -> bool:
         """Looked from nearby already, or its region mostly seen by the robot's own depth (from
         inside it, or nearly all of it from outside: a glimpse through a door is not a look)."""
-        if any(math.dist(p.xy, v) < 1.5 for v in visited):
+        if self._looked_from_near(p.xy, [*visited, *self._spots]):
             return True
         mask = regions == p.region
         if not mask.any():
@@ -410,6 +416,34 @@ class ObjectSearch:
         seen[inside] = obs[rc[inside, 0], rc[inside, 1]]
         frac = float(seen.mean())
         return frac >= self.config.seen_anyway or (p.region in self._looked_in and frac >= self.config.seen_fraction)
+
+    def _looked_from_near(self, xy: tuple[float, float], spots: Sequence[tuple[float, float]],
+                          radius: float = 1.5) -> bool:
+        """Looked at from within ``radius`` with nothing between on the robot's own map: two rooms'
+        standing points may lie 1.4 m apart on either side of a wall, and a look around in one does
+        not see the other (the room and the object in it were counted as looked at, never seen)."""
+        for v in spots:
+            d = math.dist(xy, v)
+            if d < 1e-6 or (d < radius and self._clear_line(v, xy)):
+                return True
+        return False
+
+    def _clear_line(self, a: tuple[float, float], b: tuple[float, float], end: float = 0.2) -> bool:
+        """No occupied cell of the online map (the saved map where the robot has not looked) on the
+        segment from ``a`` to ``b``, ``end`` metres at either end left out (a standing point taken by
+        a chair, a place given up on furniture)."""
+        own = self.explorer.map
+        if self._cells_at is None or self._cells_at[0] != self.explorer.looks:
+            self._cells_at = (self.explorer.looks, own.cells())
+        cells = self._cells_at[1]
+        d = math.dist(a, b)
+        if d <= 2 * end:
+            return True
+        t = np.linspace(end / d, 1.0 - end / d, max(2, int(np.ceil(d / (0.5 * own.spec.resolution)))))
+        pts = np.asarray(a, np.float64)[None, :] + t[:, None] * (np.asarray(b, np.float64) - np.asarray(a))[None, :]
+        rc = own.spec.to_cell(pts)
+        ok = own.spec.inside(rc)
+        return not bool((cells[rc[ok, 0], rc[ok, 1]] == OCCUPIED).any())
 
     # ------------------------------------------------------------------ going to the answer
     def _stop(self, ex: FrontierExplorer) -> bool:
