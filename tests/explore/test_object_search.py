@@ -321,9 +321,10 @@ def test_path_lengths_agree_with_the_drive_planner() -> None:
 
 def test_a_look_from_behind_a_wall_does_not_spend_a_place(first_map: CapNavMap) -> None:
     """A place to look from in room A 1.2 m from where the robot looked around in room B, the wall
-    between them: that look saw nothing of the place (s100001: a bathroom's standing point 1.4 m
-    from the bedroom's, spent by the bedroom's look, its new plant never seen). A look from as near
-    on the place's own side of the wall does spend it."""
+    between them: that look saw nothing of the place. Nor does aiming at a place nearby that could
+    not be stood on and was looked from elsewhere (s100001: a room's standing point 1.4 m from one
+    the robot aimed at and looked from a metre off, spent unseen, its new plant never seen). A look
+    from as near on the place's own side of the wall does spend it."""
     from capnav.explore.places import Place, room_places
 
     agent = BoxAgent(_room_a((-0.3, 2.0)), -1.2, -0.8, 0.0)
@@ -334,5 +335,9 @@ def test_a_look_from_behind_a_wall_does_not_spend_a_place(first_map: CapNavMap) 
     here = (0.1, -1.5)
     rc = first_map.occupancy.spec.to_cell(np.asarray(here))
     place = Place(here, int(regions[rc[0], rc[1]]), 0.5, "room A by the wall")
-    assert not s._spent(place, [(1.3, -1.5)], regions)  # room B, 1.2 m away, behind the wall
-    assert s._spent(place, [(-1.0, -1.5)], regions)  # room A, 1.1 m away, in the open
+    s._spots = [(1.3, -1.5)]  # looked around in room B, 1.2 m away, behind the wall
+    assert not s._spent(place, [], regions)
+    # Aimed at a place in room A 1.1 m away that could not be stood on, looked from room B.
+    assert not s._spent(place, [(-1.0, -1.5)], regions)
+    s._spots.append((-1.0, -1.4))  # looked around in room A, 1.1 m away, in the open
+    assert s._spent(place, [], regions)

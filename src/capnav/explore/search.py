@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import ndimage
 
 from capnav.core.errors import CapNavError, InputError
 from capnav.core.grid import FREE, OCCUPIED, OccupancyGrid
@@ -240,16 +241,12 @@ class ObjectSearch:
             self._log("search", f"go to ({p.xy[0]:.2f}, {p.xy[1]:.2f}), {dist[k]:.1f} m away: {p.why}, prior "
                                 f"{p.prior:.2f}, best of {len(cands)} places", p.xy)
             ex.forgive_contacts = lvl.forgive_contacts
-            if p.region == SECOND_LOOK:  # the object itself stands there: look at it from a step back
-                st = ex.approach(_fixed(p.xy), cfg.second_look_m, self._stop, planner=lvl.planner)
-                st = Status.ARRIVED if st is Status.BLOCKED and math.dist(ex.xy, p.xy) < 2 * cfg.second_look_m else st
-            else:
-                st = ex.drive_to(p.xy, self._stop, planner=lvl.planner)
-                if st is Status.BLOCKED and math.dist(ex.xy, p.xy) > cfg.place_reach:
-                    # The standing point is taken now (a chair set down on it): look from a free cell near it.
-                    self._log("search", f"({p.xy[0]:.2f}, {p.xy[1]:.2f}) cannot be stood on; going to a free cell "
-                                        f"within {cfg.place_reach:.1f} m of it", ex.xy)
-                    st = ex.approach(_fixed(p.xy), cfg.place_reach, self._stop, planner=lvl.planner)
+            for attempt in range(2):
+                before = self.driven()
+                st = self._go(p, lvl)
+                if st is not Status.BLOCKED or attempt or self.driven() - before > 0.05 or not self._unstick():
+                    break
+                ex.forgive_contacts = False  # the marks of the steps that touched say where not to go again
             ex.forgive_contacts = False
             visited.append(p.xy)
             self._looked_in.add(self._region_at(regions, ex.xy))
@@ -260,6 +257,55 @@ class ObjectSearch:
                 self._spots.append(ex.xy)
                 ex.look_around(self._stop)
         return self._out_of_budget()
+
+    def _go(self, p: Place, lvl: Level) -> Status:
+        """Drive to a place to look from (an object seen: to a step back from it)."""
+        cfg, ex = self.config, self.explorer
+        if p.region == SECOND_LOOK:  # the object itself stands there: look at it from a step back
+            st = ex.approach(_fixed(p.xy), cfg.second_look_m, self._stop, planner=lvl.planner)
+            return Status.ARRIVED if st is Status.BLOCKED and math.dist(ex.xy, p.xy) < 2 * cfg.second_look_m else st
+        st = ex.drive_to(p.xy, self._stop, planner=lvl.planner)
+        if st is Status.BLOCKED and math.dist(ex.xy, p.xy) > cfg.place_reach:
+            # The standing point is taken now (a chair set down on it): look from a free cell near it.
+            self._log("search", f"({p.xy[0]:.2f}, {p.xy[1]:.2f}) cannot be stood on; going to a free cell "
+                                f"within {cfg.place_reach:.1f} m of it", ex.xy)
+            st = ex.approach(_fixed(p.xy), cfg.place_reach, self._stop, planner=lvl.planner)
+        return st
+
+    def _unstick(self, tries: int = 4) -> bool:
+        """A drive that could not leave the spot: the robot touches furniture (a relaxed inflation
+        lets its 0.2 m body plan 0.175 m from things) and every first step of the plan, turned to
+        the nearest 30 degrees, runs into it. Turn to the heading whose next step lands farthest from
+        anything occupied on the robot's own map, and take that step; True when a step was taken."""
+        ex = self.explorer
+        grid = ex.grid()
+        spec = grid.spec
+        clear = ndimage.distance_transform_edt(grid.cells != OCCUPIED) * spec.resolution
+        x, y, yaw = (float(v) for v in self.agent.pose)
+        n = max(1, round(2 * math.pi / ex.turn))
+
+        def clearance(k: int) -> float:
+            h = yaw + k * ex.turn
+            rc = spec.to_cell(np.array([x + ex.forward * math.cos(h), y + ex.forward * math.sin(h)]))
+            return float(clear[rc[0], rc[1]]) if spec.inside(rc) else 0.0
+
+        order = sorted(range(n), key=lambda k: -clearance(k))
+        at = 0
+        for k in order[:tries]:
+            turns = (k - at) % n
+            action = "turn_left" if turns <= n // 2 else "turn_right"
+            for _ in range(turns if turns <= n // 2 else n - turns):
+                if ex.budget <= 0:
+                    return False
+                ex.act(action)
+            at = k
+            if ex.budget <= 0:
+                return False
+            if ex.act("move_forward"):
+                self._log("search", f"could not leave ({x:.2f}, {y:.2f}): every first step touched something; "
+                                    f"stepped away from it, {clearance(k):.2f} m clear ahead", ex.xy)
+                return True
+        return False
 
     def _choices(self, places: Sequence[Place], visited: Sequence[tuple[float, float]],
                  regions: np.ndarray) -> tuple[list[Place], np.ndarray, int]:
@@ -396,9 +442,11 @@ class ObjectSearch:
         return int(regions[rc[0], rc[1]])
 
     def _spent(self, p: Place, visited: Sequence[tuple[float, float]], regions: np.ndarray) -> bool:
-        """Looked from nearby already, or its region mostly seen by the robot's own depth (from
-        inside it, or nearly all of it from outside: a glimpse through a door is not a look)."""
-        if self._looked_from_near(p.xy, [*visited, *self._spots]):
+        """Aimed at already, or looked around at from nearby (where the robot stood, not where it
+        aimed: a place that could not be stood on is looked from up to a metre off, maybe in the
+        next room), or its region mostly seen by the robot's own depth (from inside it, or nearly
+        all of it from outside: a glimpse through a door is not a look)."""
+        if any(math.dist(p.xy, v) < 1e-6 for v in visited) or self._looked_from_near(p.xy, self._spots):
             return True
         mask = regions == p.region
         if not mask.any():
