@@ -274,3 +274,70 @@ def test_a_door_narrower_than_the_robot_and_its_margin_is_planned_through(first_
     assert res.found, res.reason
     assert _gap(agent, next(b for b in world if b.category == LAMP)) <= 1.0
     assert any("planning with inflation 0.200 m" in s.reason for s in res.steps), res.steps
+
+
+def test_path_lengths_agree_with_the_drive_planner() -> None:
+    """Every place the search's path lengths call reachable is one the drive plans to (the start
+    snapped as the planner snaps it, a blocked target looked at from a passable cell within reach),
+    and no other: a start boxed in between a cabinet and a wall is not snapped behind the wall."""
+    from capnav.core.errors import CapNavError
+    from capnav.core.grid import FREE, OCCUPIED, GridSpec, OccupancyGrid
+    from capnav.explore.search import path_lengths
+    from capnav.planning import PlannerConfig, build_costmap, plan_path
+
+    spec = GridSpec(0.0, 0.0, 0.05, 60, 80)  # 4 x 3 m
+    cells = np.full((60, 80), FREE, np.uint8)
+    cells[:, 40:43] = OCCUPIED  # a wall at x 2.00-2.15 ...
+    cells[22:38, 40:43] = FREE  # ... with a 0.8 m door at y 1.1-1.9
+    cells[:20, 29:31] = OCCUPIED  # a cabinet's side at x 1.45-1.55, y 0-1: a 0.45 m gap beside the wall
+    cells[52:, 60:] = OCCUPIED  # a block in room B's corner (x 3-4, y 2.6-3)
+    grid = OccupancyGrid(spec, cells)
+    cfg = PlannerConfig()
+    cm = build_costmap(grid, cfg)
+    targets = [(3.5, 0.5), (3.5, 2.2), (0.5, 0.5), (1.78, 2.8), (3.5, 2.95), (1.78, 0.4)]
+    reach = 1.0
+
+    def drivable(start: tuple[float, float], t: tuple[float, float]) -> bool:
+        rc = spec.to_cell(np.asarray(t))
+        k = int(np.ceil(reach / spec.resolution))
+        goals = [t] if np.isfinite(cm.weights[rc[0], rc[1]]) else [
+            (float(x), float(y)) for x, y in spec.to_world(np.argwhere(np.isfinite(cm.weights)))
+            if math.dist((x, y), t) <= reach and abs(x - t[0]) <= k * spec.resolution]
+        for g in goals:
+            try:
+                plan_path(grid, start, g, cfg, cm)
+                return True
+            except CapNavError:
+                continue
+        return False
+
+    for start in ((0.5, 2.0), (1.78, 0.5)):  # in room A; boxed in the gap (no passable cell within 0.5 m)
+        got = path_lengths(grid, cm, start, targets, cfg, reach)
+        for t, d in zip(targets, got, strict=True):
+            assert drivable(start, t) == bool(np.isfinite(d)), (start, t, d)
+    assert np.isfinite(path_lengths(grid, cm, (0.5, 2.0), targets, cfg, reach)).sum() >= 5
+    assert not np.isfinite(path_lengths(grid, cm, (1.78, 0.5), targets, cfg, reach)).any()
+
+
+def test_a_look_from_behind_a_wall_does_not_spend_a_place(first_map: CapNavMap) -> None:
+    """A place to look from in room A 1.2 m from where the robot looked around in room B, the wall
+    between them: that look saw nothing of the place. Nor does aiming at a place nearby that could
+    not be stood on and was looked from elsewhere (s100001: a room's standing point 1.4 m from one
+    the robot aimed at and looked from a metre off, spent unseen, its new plant never seen). A look
+    from as near on the place's own side of the wall does spend it."""
+    from capnav.explore.places import Place, room_places
+
+    agent = BoxAgent(_room_a((-0.3, 2.0)), -1.2, -0.8, 0.0)
+    s = ObjectSearch(first_map, agent, create_detector("sim", noise="oracle", seed=0), Retriever(first_map, _EMB[0]),
+                     SearchConfig())  # type: ignore[arg-type]
+    _, regions = room_places(first_map, "plant", _EMB[0])  # type: ignore[arg-type]
+    s._looked_in = set()
+    here = (0.1, -1.5)
+    rc = first_map.occupancy.spec.to_cell(np.asarray(here))
+    place = Place(here, int(regions[rc[0], rc[1]]), 0.5, "room A by the wall")
+    s._spots = [(1.3, -1.5)]  # looked around in room B, 1.2 m away, behind the wall
+    assert not s._spent(place, [], regions)
+    # Aimed at a place in room A 1.1 m away that could not be stood on, looked from room B.
+    assert not s._spent(place, [(-1.0, -1.5)], regions)
+    s._spots.append((-1.0, -1.4))  # looked around in room A, 1.1 m away, in the open
+    assert s._spent(place, [], regions)

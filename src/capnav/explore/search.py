@@ -26,9 +26,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
+from scipy import ndimage
 
-from capnav.core.errors import InputError
-from capnav.core.grid import FREE
+from capnav.core.errors import CapNavError, InputError
+from capnav.core.grid import FREE, OCCUPIED, OccupancyGrid
 from capnav.explore.explorer import ExplorerConfig, FrontierExplorer, Status
 from capnav.explore.levels import Level, search_levels
 from capnav.explore.live_map import LiveMap, LiveMapConfig, Snapshot
@@ -36,7 +38,8 @@ from capnav.explore.online_map import OnlineMap, OnlineMapConfig
 from capnav.explore.places import Place, PlaceConfig, room_places
 from capnav.language.embedder import TextEmbedder
 from capnav.mapping.cmap import CapNavMap, MapObject
-from capnav.planning import PlannerConfig
+from capnav.planning import Costmap, PlannerConfig
+from capnav.planning.costmap import locate_start
 from capnav.planning.search import cost_field
 from capnav.retrieval.query import ParsedQuery, parse_goals
 from capnav.retrieval.result import QueryResult
@@ -168,6 +171,8 @@ class ObjectSearch:
         self._snap: Snapshot | None = None
         self._found_id: int | None = None
         self._answered: dict[int, MapObject] = {}  # saved objects that were the answer at some time
+        self._spots: list[tuple[float, float]] = []  # where the robot looked around
+        self._cells_at: tuple[int, np.ndarray] | None = None  # the online map's cells, at a number of views
 
     # ------------------------------------------------------------------ the request
     def run(self, instruction: str | ParsedQuery, first: QueryResult | None = None) -> SearchResult:
@@ -206,6 +211,7 @@ class ObjectSearch:
         places, regions = room_places(self.cmap, self._parsed.category, self.embedder, cfg.places)
         visited: list[tuple[float, float]] = []
         self._looked_in: set[int] = {self._region_at(regions, ex.xy)}
+        self._spots.append(ex.xy)  # looked around where the request was heard
         while not self._over(None):
             ans = self._ask(force=True)
             if ans.kind in ("new", "confirmed") and ans.obj is not None:
@@ -235,16 +241,12 @@ class ObjectSearch:
             self._log("search", f"go to ({p.xy[0]:.2f}, {p.xy[1]:.2f}), {dist[k]:.1f} m away: {p.why}, prior "
                                 f"{p.prior:.2f}, best of {len(cands)} places", p.xy)
             ex.forgive_contacts = lvl.forgive_contacts
-            if p.region == SECOND_LOOK:  # the object itself stands there: look at it from a step back
-                st = ex.approach(_fixed(p.xy), cfg.second_look_m, self._stop, planner=lvl.planner)
-                st = Status.ARRIVED if st is Status.BLOCKED and math.dist(ex.xy, p.xy) < 2 * cfg.second_look_m else st
-            else:
-                st = ex.drive_to(p.xy, self._stop, planner=lvl.planner)
-                if st is Status.BLOCKED and math.dist(ex.xy, p.xy) > cfg.place_reach:
-                    # The standing point is taken now (a chair set down on it): look from a free cell near it.
-                    self._log("search", f"({p.xy[0]:.2f}, {p.xy[1]:.2f}) cannot be stood on; going to a free cell "
-                                        f"within {cfg.place_reach:.1f} m of it", ex.xy)
-                    st = ex.approach(_fixed(p.xy), cfg.place_reach, self._stop, planner=lvl.planner)
+            for attempt in range(2):
+                before = self.driven()
+                st = self._go(p, lvl)
+                if st is not Status.BLOCKED or attempt or self.driven() - before > 0.05 or not self._unstick():
+                    break
+                ex.forgive_contacts = False  # the marks of the steps that touched say where not to go again
             ex.forgive_contacts = False
             visited.append(p.xy)
             self._looked_in.add(self._region_at(regions, ex.xy))
@@ -252,8 +254,58 @@ class ObjectSearch:
                 self._log("search", f"could not get to ({p.xy[0]:.2f}, {p.xy[1]:.2f}); giving it up", ex.xy)
             elif not self._over(st) and st is not Status.STOPPED:
                 self._log("look", "looking around", ex.xy)
+                self._spots.append(ex.xy)
                 ex.look_around(self._stop)
         return self._out_of_budget()
+
+    def _go(self, p: Place, lvl: Level) -> Status:
+        """Drive to a place to look from (an object seen: to a step back from it)."""
+        cfg, ex = self.config, self.explorer
+        if p.region == SECOND_LOOK:  # the object itself stands there: look at it from a step back
+            st = ex.approach(_fixed(p.xy), cfg.second_look_m, self._stop, planner=lvl.planner)
+            return Status.ARRIVED if st is Status.BLOCKED and math.dist(ex.xy, p.xy) < 2 * cfg.second_look_m else st
+        st = ex.drive_to(p.xy, self._stop, planner=lvl.planner)
+        if st is Status.BLOCKED and math.dist(ex.xy, p.xy) > cfg.place_reach:
+            # The standing point is taken now (a chair set down on it): look from a free cell near it.
+            self._log("search", f"({p.xy[0]:.2f}, {p.xy[1]:.2f}) cannot be stood on; going to a free cell "
+                                f"within {cfg.place_reach:.1f} m of it", ex.xy)
+            st = ex.approach(_fixed(p.xy), cfg.place_reach, self._stop, planner=lvl.planner)
+        return st
+
+    def _unstick(self, tries: int = 4) -> bool:
+        """A drive that could not leave the spot: the robot touches furniture (a relaxed inflation
+        lets its 0.2 m body plan 0.175 m from things) and every first step of the plan, turned to
+        the nearest 30 degrees, runs into it. Turn to the heading whose next step lands farthest from
+        anything occupied on the robot's own map, and take that step; True when a step was taken."""
+        ex = self.explorer
+        grid = ex.grid()
+        spec = grid.spec
+        clear = ndimage.distance_transform_edt(grid.cells != OCCUPIED) * spec.resolution
+        x, y, yaw = (float(v) for v in self.agent.pose)
+        n = max(1, round(2 * math.pi / ex.turn))
+
+        def clearance(k: int) -> float:
+            h = yaw + k * ex.turn
+            rc = spec.to_cell(np.array([x + ex.forward * math.cos(h), y + ex.forward * math.sin(h)]))
+            return float(clear[rc[0], rc[1]]) if spec.inside(rc) else 0.0
+
+        order = sorted(range(n), key=lambda k: -clearance(k))
+        at = 0
+        for k in order[:tries]:
+            turns = (k - at) % n
+            action = "turn_left" if turns <= n // 2 else "turn_right"
+            for _ in range(turns if turns <= n // 2 else n - turns):
+                if ex.budget <= 0:
+                    return False
+                ex.act(action)
+            at = k
+            if ex.budget <= 0:
+                return False
+            if ex.act("move_forward"):
+                self._log("search", f"could not leave ({x:.2f}, {y:.2f}): every first step touched something; "
+                                    f"stepped away from it, {clearance(k):.2f} m clear ahead", ex.xy)
+                return True
+        return False
 
     def _choices(self, places: Sequence[Place], visited: Sequence[tuple[float, float]],
                  regions: np.ndarray) -> tuple[list[Place], np.ndarray, int]:
@@ -273,7 +325,8 @@ class ObjectSearch:
                             f"a frontier of unseen space ({f.size} cells)")
                       for f in fronts if all(math.dist(f.target_xy, v) > ex.config.visited_radius for v in visited)]
             cands += self._second_looks(visited)
-            dist = self._path_lengths(grid, cm, [p.xy for p in cands]) if cands else np.zeros(0)
+            reach = [cfg.second_look_m if p.region == SECOND_LOOK else cfg.place_reach for p in cands]
+            dist = path_lengths(grid, cm, ex.xy, [p.xy for p in cands], lvl.planner, reach) if cands else np.zeros(0)
             if np.isfinite(dist).any():
                 return cands, dist, level
             if first is None or (cands and not first[0]):
@@ -314,6 +367,7 @@ class ObjectSearch:
         if st is Status.STOPPED or self._over(st):
             return
         self._log("look", f"at the map's place of object {o.id}: looking around", ex.xy)
+        self._spots.append(ex.xy)
         if ex.look_around(self._stop) is Status.STOPPED:
             return
         ans = self._ask(force=True)
@@ -321,6 +375,7 @@ class ObjectSearch:
             return
         if self.live.frames and o.id not in self._answer_ids("confirmed"):
             self.live.absent.add(o.id)
+            self._asked_at = -1  # ask again now, without it (not after another look around at the same place)
             self._log("search", f"not at its place: object {o.id} not seen within {cfg.at_place + 0.2:.1f} m of "
                                 f"where the map has it after {ex.looks} views; asking again without it", ex.xy)
 
@@ -387,9 +442,11 @@ class ObjectSearch:
         return int(regions[rc[0], rc[1]])
 
     def _spent(self, p: Place, visited: Sequence[tuple[float, float]], regions: np.ndarray) -> bool:
-        """Looked from nearby already, or its region mostly seen by the robot's own depth (from
-        inside it, or nearly all of it from outside: a glimpse through a door is not a look)."""
-        if any(math.dist(p.xy, v) < 1.5 for v in visited):
+        """Aimed at already, or looked around at from nearby (where the robot stood, not where it
+        aimed: a place that could not be stood on is looked from up to a metre off, maybe in the
+        next room), or its region mostly seen by the robot's own depth (from inside it, or nearly
+        all of it from outside: a glimpse through a door is not a look)."""
+        if any(math.dist(p.xy, v) < 1e-6 for v in visited) or self._looked_from_near(p.xy, self._spots):
             return True
         mask = regions == p.region
         if not mask.any():
@@ -408,28 +465,33 @@ class ObjectSearch:
         frac = float(seen.mean())
         return frac >= self.config.seen_anyway or (p.region in self._looked_in and frac >= self.config.seen_fraction)
 
-    def _path_lengths(self, grid: Any, cm: Any, targets: list[tuple[float, float]]) -> np.ndarray:
-        passable = np.isfinite(cm.weights)
-        rc0 = grid.spec.to_cell(np.asarray(self.explorer.xy))
-        start = (int(np.clip(rc0[0], 0, grid.spec.rows - 1)), int(np.clip(rc0[1], 0, grid.spec.cols - 1)))
-        if not passable[start]:
-            near = np.argwhere(passable)
-            if len(near):
-                j = int(np.argmin(((near - np.asarray(start)) ** 2).sum(1)))
-                start = (int(near[j, 0]), int(near[j, 1]))
-        fld, _ = cost_field(cm.weights, start)
-        out = np.full(len(targets), np.inf)
-        rc = grid.spec.to_cell(np.asarray(targets, dtype=np.float64).reshape(-1, 2))
-        ok = grid.spec.inside(rc)
-        out[ok] = fld[rc[ok, 0], rc[ok, 1]] * grid.spec.resolution
-        # A target on an obstacle (an object to look at again): the walk to the nearest cell within a metre.
-        k = round(1.0 / grid.spec.resolution)
-        for i in np.flatnonzero(ok & ~np.isfinite(out)):
-            r, c = int(rc[i, 0]), int(rc[i, 1])
-            win = fld[max(r - k, 0):r + k + 1, max(c - k, 0):c + k + 1]
-            if np.isfinite(win).any():
-                out[i] = float(np.nanmin(np.where(np.isfinite(win), win, np.nan))) * grid.spec.resolution + 1.0
-        return out
+    def _looked_from_near(self, xy: tuple[float, float], spots: Sequence[tuple[float, float]],
+                          radius: float = 1.5) -> bool:
+        """Looked at from within ``radius`` with nothing between on the robot's own map: two rooms'
+        standing points may lie 1.4 m apart on either side of a wall, and a look around in one does
+        not see the other (the room and the object in it were counted as looked at, never seen)."""
+        for v in spots:
+            d = math.dist(xy, v)
+            if d < 1e-6 or (d < radius and self._clear_line(v, xy)):
+                return True
+        return False
+
+    def _clear_line(self, a: tuple[float, float], b: tuple[float, float], end: float = 0.2) -> bool:
+        """No occupied cell of the online map (the saved map where the robot has not looked) on the
+        segment from ``a`` to ``b``, ``end`` metres at either end left out (a standing point taken by
+        a chair, a place given up on furniture)."""
+        own = self.explorer.map
+        if self._cells_at is None or self._cells_at[0] != self.explorer.looks:
+            self._cells_at = (self.explorer.looks, own.cells())
+        cells = self._cells_at[1]
+        d = math.dist(a, b)
+        if d <= 2 * end:
+            return True
+        t = np.linspace(end / d, 1.0 - end / d, max(2, int(np.ceil(d / (0.5 * own.spec.resolution)))))
+        pts = np.asarray(a, np.float64)[None, :] + t[:, None] * (np.asarray(b, np.float64) - np.asarray(a))[None, :]
+        rc = own.spec.to_cell(pts)
+        ok = own.spec.inside(rc)
+        return not bool((cells[rc[ok, 0], rc[ok, 1]] == OCCUPIED).any())
 
     # ------------------------------------------------------------------ going to the answer
     def _stop(self, ex: FrontierExplorer) -> bool:
@@ -539,6 +601,52 @@ class ObjectSearch:
         return SearchResult(found, reason, target, self.driven(), self.steps, self.explorer.looks, from_map,
                             self._found_id if found and from_map else None, self.asks)
 
+
+
+def path_lengths(grid: OccupancyGrid, cm: Costmap, start_xy: tuple[float, float],
+                 targets: Sequence[tuple[float, float]], planner: PlannerConfig,
+                 reach: Sequence[float] | float = 0.0) -> NDArray[np.float64]:
+    """Metres of the drive from ``start_xy`` to each target, as the drive would plan it: the start
+    snapped to a passable cell as ``planning.locate_start`` snaps it (within the planner's escape
+    radius, else nothing is reachable: the drive would refuse to plan), a target on a passable cell
+    reached there, a blocked one (an object, a room's point on furniture) at the cheapest passable
+    cell within ``reach`` of it (the approach that stops that close), else never (inf).
+
+    Why: a start in the inflation band snapped to the nearest passable cell anywhere may land
+    behind a wall, and then places look reachable at a strict inflation that the drive refuses
+    (every drive "could not get to"), and the relaxed levels that would get the robot out are
+    never tried."""
+    n = len(targets)
+    out = np.full(n, np.inf)
+    if n == 0:
+        return out
+    try:
+        s_cell, _ = locate_start(cm, start_xy, planner)
+    except CapNavError:
+        return out
+    fld, _ = cost_field(cm.weights, s_cell)
+    spec = grid.spec
+    res = spec.resolution
+    radii = np.broadcast_to(np.asarray(reach, dtype=np.float64), (n,))
+    rc = spec.to_cell(np.asarray(targets, dtype=np.float64).reshape(-1, 2))
+    ok = spec.inside(rc)
+    out[ok] = fld[rc[ok, 0], rc[ok, 1]] * res
+    for i in np.flatnonzero(~np.isfinite(out) & (radii > 0)):
+        k = int(np.ceil(radii[i] / res))
+        r, c = int(rc[i, 0]), int(rc[i, 1])
+        r0, c0 = max(r - k, 0), max(c - k, 0)
+        r1, c1 = min(r + k + 1, spec.rows), min(c + k + 1, spec.cols)
+        if r0 >= r1 or c0 >= c1:
+            continue
+        win = fld[r0:r1, c0:c1]
+        rr, cc = np.mgrid[r0:r1, c0:c1]
+        centres = spec.to_world(np.stack([rr.ravel(), cc.ravel()], axis=1)).reshape(r1 - r0, c1 - c0, 2)
+        tx, ty = targets[int(i)]
+        near = np.hypot(centres[..., 0] - tx, centres[..., 1] - ty) <= radii[i]
+        vals = win[near & np.isfinite(win)]
+        if vals.size:
+            out[i] = float(vals.min()) * res
+    return out
 
 def search_goal(cmap: CapNavMap, retriever: Any, instruction: Any, agent: Any, detector: Any,
                 config: SearchConfig | None = None) -> tuple[Any, SearchResult]:

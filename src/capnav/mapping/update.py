@@ -580,6 +580,19 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
         slots = vox.slots(vox.index_of(own))
         slots = np.unique(slots[slots >= 0])
         carve[slots[v_seen[slots] == 0]] = True
+        # Its masks may have missed part of its surface (a strip no mask held is voxels no object
+        # owns): inside its box, above the floor, what no object that stays owns and the new
+        # recording did not see goes too, else specks of it stay obstacles where it stood.
+        stay = [np.asarray(o.points, np.float64).reshape(-1, 3) for q, o in enumerate(old) if q not in left]
+        owned = np.zeros(len(vox), bool)
+        if stay:
+            s_slots = vox.slots(vox.index_of(np.concatenate(stay)))
+            owned[s_slots[s_slots >= 0]] = True
+        floor = mapper.config.occupancy.floor_max
+        for q in left:
+            lo, hi = np.asarray(old[q].extent_min, np.float64), np.asarray(old[q].extent_max, np.float64)
+            inside = np.all((vc >= lo) & (vc <= hi), axis=1) & (vc[:, 2] >= floor)
+            carve[inside & ~owned & (v_seen == 0)] = True
     rep.voxels_carved = int(carve.sum())
     voxels = _merge_voxels(vox, ~carve, sub.voxels)
     occ = occupancy_from_voxels(voxels, mapper.config.occupancy)
