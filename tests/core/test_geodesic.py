@@ -1,6 +1,8 @@
 """The bucket-queue walking distance gives the very floats of a heap-ordered Dijkstra (the routine
 it replaced, kept here in plain Python as the reference), with and without a distance limit, and
-walking distances to objects keep their order where it differs from the straight line."""
+walking distances to objects keep their order where it differs from the straight line. Walking
+distances to objects are exact (a + b sqrt 2 from the step counts): the reference counts steps
+too, and an object's walk field read at a robot's cell gives the float of the walk from the robot."""
 
 from __future__ import annotations
 
@@ -19,10 +21,13 @@ _MOVES = [(-1, -1, math.sqrt(2)), (-1, 0, 1.0), (-1, 1, math.sqrt(2)), (0, -1, 1
           (1, -1, math.sqrt(2)), (1, 0, 1.0), (1, 1, math.sqrt(2))]
 
 
-def heap_dijkstra(domain: np.ndarray, seeds: np.ndarray, limit: float) -> np.ndarray:
-    """The replaced routine: a binary heap, no closed set, cells past ``limit`` not expanded."""
+def heap_dijkstra(domain: np.ndarray, seeds: np.ndarray, limit: float, exact: bool = False) -> np.ndarray:
+    """The replaced routine: a binary heap, no closed set, cells past ``limit`` not expanded.
+    ``exact``: each distance is a + b sqrt 2 from its path's counts of straight (a) and diagonal
+    (b) steps, not summed step by step (the walking distances to objects)."""
     rows, cols = domain.shape
     dist = np.full((rows, cols), np.inf)
+    counts = np.zeros((rows, cols, 2), np.int64)
     heap: list[tuple[float, int, int]] = []
     for r, c in seeds:
         dist[r, c] = 0.0
@@ -34,9 +39,14 @@ def heap_dijkstra(domain: np.ndarray, seeds: np.ndarray, limit: float) -> np.nda
             continue
         for dr, dc, w in _MOVES:
             rr, cc = r + dr, c + dc
-            if 0 <= rr < rows and 0 <= cc < cols and domain[rr, cc] and d + w < dist[rr, cc]:
-                dist[rr, cc] = d + w
-                heapq.heappush(heap, (d + w, rr, cc))
+            if not (0 <= rr < rows and 0 <= cc < cols and domain[rr, cc]):
+                continue
+            a, b = counts[r, c] + ((0, 1) if dr and dc else (1, 0))
+            nd = float(a) + float(b) * math.sqrt(2) if exact else d + w
+            if nd < dist[rr, cc]:
+                dist[rr, cc] = nd
+                counts[rr, cc] = a, b
+                heapq.heappush(heap, (nd, rr, cc))
     return dist
 
 
@@ -101,7 +111,7 @@ def test_walking_order_differs_from_the_straight_line_and_matches_the_reference(
     line = np.hypot(*((los + his) / 2 - robot).T)
     assert np.argmin(line) == 0 and np.argmin(d) == 1
     rc = spec.to_cell(np.asarray(robot))
-    ref_field = heap_dijkstra(floor.domain, np.array([rc], np.int64), math.inf) * spec.resolution
+    ref_field = heap_dijkstra(floor.domain, np.array([rc], np.int64), math.inf, exact=True) * spec.resolution
     ref = np.array([box_min(ref_field, spec, lo, hi) for lo, hi in zip(los, his, strict=True)])
     np.testing.assert_array_equal(d, ref)
     assert floor.from_point(robot) is d  # cached per source cell
@@ -141,7 +151,8 @@ def test_floor_distances_give_the_floats_of_the_heap_dijkstra_and_the_per_box_lo
     for r, c in free[rng.choice(len(free), size=6, replace=False)]:
         xy = spec.to_world(np.array([r, c]))
         got = floor.from_point((float(xy[0]), float(xy[1])))
-        field = heap_dijkstra(floor.domain, np.array([spec.to_cell(xy)], np.int64), math.inf) * spec.resolution
+        field = heap_dijkstra(floor.domain, np.array([spec.to_cell(xy)], np.int64), math.inf,
+                              exact=True) * spec.resolution
         ref = np.array([box_min(field, spec, lo, hi, RING) for lo, hi in zip(los, his, strict=True)])
         np.testing.assert_array_equal(got, ref)
         finite += int(np.isfinite(ref).sum())
@@ -150,7 +161,7 @@ def test_floor_distances_give_the_floats_of_the_heap_dijkstra_and_the_per_box_lo
     field = heap_dijkstra(floor.domain, np.concatenate(
         [np.argwhere(np.ones((b[2] - b[0] + 1, b[3] - b[1] + 1), bool)) + b[:2]
          for b in (np.array(box_cells(spec, los[i], his[i])) for i in pair)
-         if b[2] >= b[0] and b[3] >= b[1]]).astype(np.int64), math.inf) * spec.resolution
+         if b[2] >= b[0] and b[3] >= b[1]]).astype(np.int64), math.inf, exact=True) * spec.resolution
     ref = np.array([box_min(field, spec, lo, hi, RING) for lo, hi in zip(los, his, strict=True)])
     np.testing.assert_array_equal(floor.from_objects(pair), ref)
     assert 0 < finite < 6 * len(los) and ring > 0  # unreached boxes, and one measured at its ring

@@ -26,6 +26,7 @@ from capnav.planning.search import (
     OPEN,
     SQRT2,
     TIE_BREAK,
+    UNSEEN,
     _grid,
     _grow,
     _min_finite,
@@ -33,14 +34,26 @@ from capnav.planning.search import (
     _push,
 )
 
+#: A cell of a goal field from which no target is reachable.
+NO_PATH = 65535
+#: A goal field's unit: 1/32 of a cell's cost (a uint16 holds costs up to 2048 cells; larger ones
+#: are stored as 2048, still a lower bound).
+FIELD_UNIT = 1.0 / 32.0
+
 
 @njit(cache=True, nogil=True)
 def _resume(w: NDArray[np.floating], g: NDArray[np.float64], state: NDArray[np.uint8], hf: NDArray[np.float64],
-            hi: NDArray[np.int64], size: int, target: NDArray[np.bool_], box: NDArray[np.int64], hscale: float
-            ) -> tuple[int, int, NDArray[np.float64], NDArray[np.int64]]:
+            hi: NDArray[np.int64], size: int, target: NDArray[np.bool_], box: NDArray[np.int64], hscale: float,
+            hq: NDArray[np.uint16], hunit: float) -> tuple[int, int, NDArray[np.float64], NDArray[np.int64]]:
     """Run until a target cell is settled (returned after expanding it) or the heap is empty (-1).
-    ``target`` covers ``box`` only (its rows, cols): the cells outside it are never targets."""
+    ``target`` covers ``box`` only (its rows, cols): the cells outside it are never targets.
+
+    ``hq`` (empty: the octile distance to the box, times ``hscale``) is a lower bound of every
+    cell's cost to the targets in units of ``hunit`` (``NO_PATH``: none reachable, the cell is
+    not entered). Rounded down, it may be inconsistent by one unit, so a settled cell is opened
+    again when a cheaper way to it turns up: the first target settled is still the cheapest."""
     rows, cols = w.shape
+    field = hq.shape[0] > 0
     flat = w.ravel()
     r0, c0, r1, c1 = box[0], box[1], box[2], box[3]
     bw = c1 - c0 + 1
@@ -68,18 +81,25 @@ def _resume(w: NDArray[np.floating], g: NDArray[np.float64], state: NDArray[np.u
             if not wv < np.inf:
                 continue
             sv = state[v]
-            if sv == CLOSED:
+            if sv == CLOSED and not field:
                 continue
             ng = gu + _STEP[k] * 0.5 * (wu + wv)
-            if ng < (g[v] if sv == OPEN else np.inf):
+            if ng < (g[v] if sv != UNSEEN else np.inf):
+                if field:
+                    hv = hq[v]
+                    if hv == NO_PATH:
+                        continue
+                    h = hunit * hv
+                else:
+                    # The octile distance to the box, inline.
+                    dr = max(r0 - vr, 0, vr - r1)
+                    dc = max(c0 - vc, 0, vc - c1)
+                    h = hscale * ((SQRT2 - 1.0) * min(dr, dc) + max(dr, dc))
                 g[v] = ng
                 state[v] = OPEN
                 if size == hf.shape[0]:
                     hf, hi = _grow(hf, hi)
-                # The octile distance to the box, inline.
-                dr = max(r0 - vr, 0, vr - r1)
-                dc = max(c0 - vc, 0, vc - c1)
-                _push(hf, hi, size, ng + hscale * ((SQRT2 - 1.0) * min(dr, dc) + max(dr, dc)), v)
+                _push(hf, hi, size, ng + h, v)
                 size += 1
         if r0 <= ur <= r1 and c0 <= uc <= c1 and target[(ur - r0) * bw + uc - c0]:
             return u, size, hf, hi
@@ -90,10 +110,16 @@ class NearestSearch:
     """Settle the cells of ``target`` (bool, the grid's shape or the shape of ``box`` = (r0, c0, r1,
     c1) inclusive, all of its cells inside the box) in increasing path cost from ``start`` on
     ``weights``; ``next()`` gives the next one. ``min_weight`` (the smallest finite weight) saves a
-    scan of the grid when the caller knows it."""
+    scan of the grid when the caller knows it; 0 searches without a heuristic (a Dijkstra).
 
-    def __init__(self, weights: NDArray[np.floating], start: tuple[int, int], target: NDArray[np.bool_],
-                 box: tuple[int, int, int, int], min_weight: float | None = None) -> None:
+    ``start`` may be several cells ((K, 2) rows, cols: a search from the nearest of them).
+    ``field`` (uint16, one per cell of the grid, from :func:`goal_field`) replaces the octile
+    distance to the box as the heuristic: a lower bound of each cell's cost to the targets, so
+    the search heads for the cheapest target along its path instead of spreading towards the box."""
+
+    def __init__(self, weights: NDArray[np.floating], start: tuple[int, int] | NDArray[np.integer],
+                 target: NDArray[np.bool_], box: tuple[int, int, int, int], min_weight: float | None = None,
+                 field: NDArray[np.uint16] | None = None) -> None:
         self.w = _grid(np.asarray(weights))  # a float32 costmap as it is: no copy per search
         rows, cols = self.w.shape
         n = rows * cols
@@ -111,13 +137,19 @@ class NearestSearch:
         self.target = np.ascontiguousarray(t).ravel()
         # Ties of f broken towards deeper cells (as A* in search.py): far fewer expansions on open floor.
         self.hscale = (_min_finite(self.w.ravel()) if min_weight is None else min_weight) * (1.0 + TIE_BREAK)
-        s = int(start[0]) * cols + int(start[1])
-        self.g[s] = 0.0
-        self.state[s] = OPEN
-        self.hf = np.empty(4096, np.float64)
-        self.hi = np.empty(4096, np.int64)
-        _push(self.hf, self.hi, 0, 0.0, s)
-        self.size = 1
+        if field is not None and field.shape != (n,):
+            raise ValueError(f"field must hold one value per cell ({n}), got shape {field.shape}")
+        self.hq = np.zeros(0, np.uint16) if field is None else field
+        self.hunit = FIELD_UNIT * (1.0 + TIE_BREAK)
+        starts = np.asarray(start, dtype=np.int64).reshape(-1, 2)
+        flat = np.unique(starts[:, 0] * cols + starts[:, 1])
+        self.hf = np.empty(max(4096, 2 * len(flat)), np.float64)
+        self.hi = np.empty(len(self.hf), np.int64)
+        self.g[flat] = 0.0
+        self.state[flat] = OPEN
+        self.hf[:len(flat)] = 0.0  # equal keys: any order is a heap
+        self.hi[:len(flat)] = flat
+        self.size = len(flat)
         self.exhausted = False
 
     def next(self) -> tuple[tuple[int, int], float] | None:
@@ -125,7 +157,7 @@ class NearestSearch:
         if self.exhausted:
             return None
         u, self.size, self.hf, self.hi = _resume(self.w, self.g, self.state, self.hf, self.hi, self.size,
-                                                 self.target, self.box, self.hscale)
+                                                 self.target, self.box, self.hscale, self.hq, self.hunit)
         if u < 0:
             self.exhausted = True
             return None
@@ -135,8 +167,33 @@ class NearestSearch:
         """Search on to the end; the cost (rows, cols) of every settled cell, inf elsewhere."""
         none = np.zeros_like(self.target)  # no target: on to the end
         if not self.exhausted:
-            _resume(self.w, self.g, self.state, self.hf, self.hi, self.size, none, self.box, self.hscale)
+            _resume(self.w, self.g, self.state, self.hf, self.hi, self.size, none, self.box, self.hscale, self.hq,
+                    self.hunit)
             self.exhausted = True
         out = np.where(self.state == CLOSED, self.g, np.inf)
         return out.reshape(self.w.shape)
 
+
+def goal_field(weights: NDArray[np.floating], sources: NDArray[np.integer], min_weight: float,
+               base: NDArray[np.float64] | None = None) -> NDArray[np.uint16]:
+    """A lower bound of the cost from every cell to the nearest of ``sources`` ((K, 2) rows, cols)
+    as a heuristic for :class:`NearestSearch` (flat, uint16 in ``FIELD_UNIT``, rounded down;
+    ``NO_PATH`` where none is reachable): the walk through the traversable cells (8-connected,
+    1 or sqrt 2 a step, :mod:`capnav.core.geodesic`'s bucket walk: a few array reads per cell,
+    no heap) times the smallest weight. Every move costs at least its step times that weight, so
+    the bound holds and changes by at most a move's cost between neighbours; where the weights
+    are the smallest (open floor) it is the cost itself. ``base``: ``walk_base`` of the
+    traversable cells, kept by the caller."""
+    from capnav.core.geodesic import _walk, walk_base
+
+    w = _grid(np.asarray(weights))
+    rows, cols = w.shape
+    if base is None:
+        base = walk_base(np.isfinite(w))
+    d = _walk(base, cols, np.asarray(sources, dtype=np.int64).reshape(-1, 2), np.inf)
+    d = d.reshape(rows + 2, cols + 2)[1:-1, 1:-1].ravel()
+    out = np.full(d.shape, NO_PATH, np.uint16)
+    ok = (d >= 0.0) & np.isfinite(d)
+    # A hair below the bound, so that rounding never lifts it above the cost a search adds up.
+    out[ok] = np.minimum(np.floor(d[ok] * (min_weight * (1.0 - 1e-12) / FIELD_UNIT)), NO_PATH - 1).astype(np.uint16)
+    return out
