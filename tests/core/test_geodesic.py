@@ -205,3 +205,51 @@ def test_a_walk_stopped_once_some_objects_are_measured_gives_their_floats(seed: 
         np.testing.assert_array_equal(part.from_point(robot, rest)[rest], ref[rest])  # filled in from here
         np.testing.assert_array_equal(part.from_point(robot), ref)
     assert stopped > 0
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3, 4])
+def test_an_objects_walk_field_gives_the_floats_of_the_walk_from_the_robot(seed: int) -> None:
+    # The field walked once from an object's cells, read at a robot's cell, is the float a walk
+    # from the robot gives at that object (exact distances: the same from either end), so a
+    # ranking from a robot position no walk started from is a lookup per object; with every field
+    # made, with none (field_bytes 0) and with room for a few (the least recently used go), from
+    # many robots, asking for some objects, one of them never reached (then the walk runs on).
+    from capnav.core.geodesic import NO_WALK, walk_field, walk_value
+
+    rng = np.random.default_rng(50 + seed)
+    spec = GridSpec(0.0, 0.0, 0.1, 30, 45)
+    dom = rooms_with_doors(rng, 30, 45)
+    dom[18:27, 30:39] = False
+    dom[19:26, 31:38] = True
+    occ = OccupancyGrid(spec, np.where(dom, FREE, OCCUPIED).astype(np.uint8))
+    los = rng.uniform([-0.4, -0.4], [4.4, 2.9], (30, 2))
+    his = los + rng.uniform(0.05, 0.6, (30, 2))
+    los[-1], his[-1] = spec.to_world(np.array([22, 35])), spec.to_world(np.array([24, 36]))  # in the closed room
+    plain = FloorDistances(occ, los, his, cache_size=0, field_bytes=0)
+    full = FloorDistances(occ, los, his, cache_size=0)
+    boxes = [box_cells(spec, lo, hi) for lo, hi in zip(los, his, strict=True)]
+    assert full.prepare() == sum(b[2] >= b[0] and b[3] >= b[1] for b in boxes)  # an empty box has no field
+    few = FloorDistances(occ, los, his, cache_size=0, field_bytes=3 * spec.rows * spec.cols * 4)
+    free = np.argwhere(plain.domain)
+    looked = 0
+    for k, (r, c) in enumerate(free[rng.choice(len(free), size=12, replace=False)]):
+        xy = spec.to_world(np.array([r, c]))
+        robot = (float(xy[0]), float(xy[1]))
+        among = rng.choice(len(los) - 1, size=1 + k % 5, replace=False)
+        if k % 4 == 3:
+            among = np.append(among, len(los) - 1)
+        ref = plain.from_point(robot, among)
+        for floor in (full, few, few):  # few: its second ranking may make the fields it lacks
+            got = floor.from_point(robot, among)
+            np.testing.assert_array_equal(got, ref)  # nan where ref is nan, the same floats elsewhere
+        box = boxes[among[0]]
+        f = full.field(int(among[0]), make=False)
+        if f is None:
+            continue
+        if f[r * spec.cols + c] != NO_WALK:
+            assert walk_value(int(f[r * spec.cols + c])) * spec.resolution == ref[among[0]]
+            looked += 1
+        seeds = np.argwhere(np.ones((box[2] - box[0] + 1, box[3] - box[1] + 1), bool)) + box[:2]
+        np.testing.assert_array_equal(walk_field(full._base, spec.cols, seeds.astype(np.int64)), f)
+    assert looked >= 4
+    assert few._held <= 3 * spec.rows * spec.cols * 4 and len(few._fields) <= 3
