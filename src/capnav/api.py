@@ -365,7 +365,10 @@ class CapNav:
                 pass
             if floor is not None:
                 walks += floor.field(i) is not None
-        return f"goal fields for {goals}, walk fields for {walks} of {len(self.map.objects)} objects"
+        held = sum(0 if f is None else f.nbytes for f in list(self.costmap.cache.get("goal_field", {}).values()))
+        held += 0 if floor is None else floor.held
+        return (f"goal fields for {goals}, walk fields for {walks} of {len(self.map.objects)} objects, "
+                f"{held / 2**20:.0f} MB")
 
     def start_pose(self) -> tuple[tuple[float, float, float], str]:
         """The default start, as ``capnav navigate`` takes it: the map's last camera pose (x, y, yaw)

@@ -195,6 +195,11 @@ class FloorDistances:
             out[i] = walk_value(v) * self.spec.resolution
         return out
 
+    @property
+    def held(self) -> int:
+        """Bytes of the walk fields kept."""
+        return self._held
+
     def prepare(self) -> int:
         """Make every object's walk field (a server does it at load, off its asks); how many
         objects have one."""
