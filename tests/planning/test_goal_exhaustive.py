@@ -178,3 +178,23 @@ def test_the_field_search_matches_the_octile_search_on_weighted_grids() -> None:
                 assert got is None or hq[s[0] * 50 + s[1]] == NO_PATH
                 continue
             assert got is not None and got[1] == pytest.approx(ref[1], rel=1e-8)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_the_goal_field_is_the_dijkstra_cost_rounded_down(dtype: type) -> None:
+    # The bucket walk gives every cell's cost to the nearest source within one unit below the
+    # heap Dijkstra's (float32 weights: each move is the float the search adds), never above it:
+    # an admissible heuristic, and NO_PATH exactly where no source is reachable.
+    from capnav.planning.nearest import FIELD_UNIT, NO_PATH, NearestSearch, goal_field
+
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        w = rng.uniform(1.0, 5.0, (60, 70)).astype(dtype)
+        w[rng.random(w.shape) < 0.25] = np.inf
+        src = np.argwhere(np.isfinite(w))[rng.choice(int(np.isfinite(w).sum()), 3, replace=False)]
+        hq = goal_field(w, src, float(w[np.isfinite(w)].min()))
+        ref = NearestSearch(w, src, np.zeros((1, 1), bool), (0, 0, 0, 0), min_weight=0.0).finish().ravel()
+        ok = np.isfinite(ref)
+        np.testing.assert_array_equal(hq == NO_PATH, ~ok)
+        gap = ref[ok] - hq[ok] * FIELD_UNIT
+        assert gap.min() >= 0.0 and gap.max() < FIELD_UNIT

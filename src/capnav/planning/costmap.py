@@ -102,7 +102,7 @@ def mark_blocked(costmap: Costmap, xy: NDArray[np.floating], radius: float, conf
     costmap.cache.pop("goal_pose", None)  # and the poses it chose on the weights before the mark
     costmap.cache.pop("goal_field", None)  # and the fields of the cells that passed the goal rule
     costmap.cache.pop("goal_field_asked", None)
-    costmap.cache.pop("goal_walk_base", None)  # the traversable cells those fields were walked on
+    costmap.cache.pop("goal_walk_base", None)  # the weights those fields were walked on
     return int(newly.sum())
 
 

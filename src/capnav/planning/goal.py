@@ -31,7 +31,7 @@ from capnav.core.errors import InputError
 from capnav.core.grid import FREE, OCCUPIED, OccupancyGrid
 from capnav.planning.config import PlannerConfig
 from capnav.planning.costmap import Costmap, build_costmap, locate_start
-from capnav.planning.nearest import NO_PATH, NearestSearch, goal_field
+from capnav.planning.nearest import NO_PATH, NearestSearch, goal_field, padded_weights
 from capnav.planning.polygon import polygon_distance
 from capnav.planning.sight import HeightColumns, SightTest
 
@@ -214,9 +214,7 @@ def _make_field(cm: Costmap, ar: _Around, cfg: PlannerConfig) -> GoalField | Non
     accepted[idx] = True
     base = cm.cache.get("goal_walk_base")
     if base is None:
-        from capnav.core.geodesic import walk_base
-
-        base = cm.cache["goal_walk_base"] = walk_base(np.isfinite(cm.weights))
+        base = cm.cache["goal_walk_base"] = padded_weights(cm.weights)
     if "min_weight" not in cm.cache:
         finite = cm.weights[np.isfinite(cm.weights)]
         cm.cache["min_weight"] = float(finite.min()) if finite.size else 1.0

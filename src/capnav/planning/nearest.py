@@ -174,26 +174,87 @@ class NearestSearch:
         return out.reshape(self.w.shape)
 
 
+def padded_weights(w: NDArray[np.floating]) -> NDArray[np.floating]:
+    """``w`` flattened on a grid padded by a one-cell border of inf (no bounds checks in
+    :func:`_cost_walk`), in ``w``'s own dtype: a move then costs the very float the search adds."""
+    w = _grid(np.asarray(w))
+    return np.pad(w, 1, constant_values=np.inf).ravel()
+
+
+@njit(cache=True, nogil=True)
+def _cost_walk(wp: NDArray[np.floating], cols: int, seeds: NDArray[np.int64], width: float, nb: int
+               ) -> NDArray[np.float64]:
+    """Path costs (the moves of :mod:`capnav.planning.search`) from the nearest seed to every
+    cell of the padded weights ``wp``, by buckets of ``width`` (at most the cheapest move, so a
+    cell's cost is final once the buckets below its own are done: Dinitz's observation, as in
+    :mod:`capnav.core.geodesic`) kept in ``nb`` rotating lists (more than the dearest move spans):
+    a few array reads per cell, no heap."""
+    w = cols + 2
+    n = wp.shape[0]
+    dist = np.full(n, np.inf)
+    lists = np.empty((nb, n + seeds.shape[0]), np.int32)
+    fill = np.zeros(nb, np.int64)
+    offs = np.array([-w - 1, -w, -w + 1, -1, 1, w - 1, w, w + 1], np.int64)
+    steps = np.array([SQRT2, 1.0, SQRT2, 1.0, 1.0, SQRT2, 1.0, SQRT2])
+    for i in range(seeds.shape[0]):
+        u = (seeds[i, 0] + 1) * w + seeds[i, 1] + 1
+        if dist[u] != 0.0:
+            dist[u] = 0.0
+            lists[0, fill[0]] = u
+            fill[0] += 1
+    pending = fill[0]
+    k = 0
+    while pending > 0:
+        slot = k % nb
+        j = 0
+        while j < fill[slot]:  # a bucket is not added to while it is expanded (moves >= width)
+            u = lists[slot, j]
+            j += 1
+            du = dist[u]
+            if int(du / width) < k:  # expanded from an earlier bucket (the push's own rounding)
+                continue
+            wu = wp[u]
+            for m in range(8):
+                v = u + offs[m]
+                wv = wp[v]
+                if not wv < np.inf:
+                    continue
+                nd = du + steps[m] * 0.5 * (wu + wv)
+                dv = dist[v]
+                if nd < dv:
+                    b = int(nd / width)
+                    if dv == np.inf or int(dv / width) != b:
+                        t = b % nb
+                        lists[t, fill[t]] = v
+                        fill[t] += 1
+                        pending += 1
+                    dist[v] = nd
+        pending -= fill[slot]
+        fill[slot] = 0
+        k += 1
+    return dist
+
+
 def goal_field(weights: NDArray[np.floating], sources: NDArray[np.integer], min_weight: float,
-               base: NDArray[np.float64] | None = None) -> NDArray[np.uint16]:
+               padded: NDArray[np.floating] | None = None) -> NDArray[np.uint16]:
     """A lower bound of the cost from every cell to the nearest of ``sources`` ((K, 2) rows, cols)
     as a heuristic for :class:`NearestSearch` (flat, uint16 in ``FIELD_UNIT``, rounded down;
-    ``NO_PATH`` where none is reachable): the walk through the traversable cells (8-connected,
-    1 or sqrt 2 a step, :mod:`capnav.core.geodesic`'s bucket walk: a few array reads per cell,
-    no heap) times the smallest weight. Every move costs at least its step times that weight, so
-    the bound holds and changes by at most a move's cost between neighbours; where the weights
-    are the smallest (open floor) it is the cost itself. ``base``: ``walk_base`` of the
-    traversable cells, kept by the caller."""
-    from capnav.core.geodesic import _walk, walk_base
-
+    ``NO_PATH`` where none is reachable): the path cost from the sources (moves cost the same both
+    ways, the mean of the two weights times the step), by a bucket walk instead of a heap.
+    ``padded``: :func:`padded_weights` of ``weights``, kept by the caller."""
     w = _grid(np.asarray(weights))
     rows, cols = w.shape
-    if base is None:
-        base = walk_base(np.isfinite(w))
-    d = _walk(base, cols, np.asarray(sources, dtype=np.int64).reshape(-1, 2), np.inf)
+    if padded is None:
+        padded = padded_weights(w)
+    finite = padded[np.isfinite(padded)]
+    width = max(float(min_weight), 1e-6)
+    dearest = SQRT2 * float(finite.max()) if finite.size else 1.0
+    d = _cost_walk(padded, cols, np.asarray(sources, dtype=np.int64).reshape(-1, 2), width,
+                   int(np.ceil(dearest / width)) + 2)
     d = d.reshape(rows + 2, cols + 2)[1:-1, 1:-1].ravel()
     out = np.full(d.shape, NO_PATH, np.uint16)
-    ok = (d >= 0.0) & np.isfinite(d)
-    # A hair below the bound, so that rounding never lifts it above the cost a search adds up.
-    out[ok] = np.minimum(np.floor(d[ok] * (min_weight * (1.0 - 1e-12) / FIELD_UNIT)), NO_PATH - 1).astype(np.uint16)
+    ok = np.isfinite(d)
+    # A hair below the cost, so that rounding never lifts the bound above the cost a search adds
+    # up (the same moves, summed in the other order).
+    out[ok] = np.minimum(np.floor(d[ok] * ((1.0 - 1e-12) / FIELD_UNIT)), NO_PATH - 1).astype(np.uint16)
     return out
