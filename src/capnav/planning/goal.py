@@ -16,6 +16,13 @@ and takes the cheapest such cell by path cost from the robot. The search settles
 cost order and stops at the first that passes (:class:`capnav.planning.nearest.NearestSearch`), so
 a goal costs the cells cheaper than it, not a whole-grid search. When no cell passes, the rule is
 relaxed one condition at a time and the reason says which one failed.
+
+Which cells pass the whole rule does not depend on where the robot stands, so an object asked
+for again (or every object, ``prepare_goal``: a server does it at load) keeps a goal field: those
+cells and a lower bound of the path cost to them from every cell (``GoalField``). The search from
+a robot no search started from then heads straight for the cheapest of them, the same cell (or
+one of equal cost) at the same cost, after a few hundred cells instead of every cell cheaper than
+the goal in every direction.
 """
 
 from __future__ import annotations

@@ -9,7 +9,9 @@ selection that accepts the first candidate it meets expands only the cells cheap
 and those towards the object; exhausting the set costs one whole-grid Dijkstra, as before.
 
 Moves and costs are those of :mod:`capnav.planning.search` (8-connected, the mean of the two
-weights times the step length).
+weights times the step length). Those costs are the same both ways, so a walk from a set of cells
+gives every cell's cost *to* them (:func:`goal_field`): with it as the heuristic the search
+follows the cheapest path to the set and expands little more than that path.
 """
 
 from __future__ import annotations
