@@ -21,8 +21,9 @@ Which cells pass the whole rule does not depend on where the robot stands, so an
 for again (or every object, ``prepare_goal``: a server does it at load) keeps a goal field: those
 cells and a lower bound of the path cost to them from every cell (``GoalField``). The search from
 a robot no search started from then heads straight for the cheapest of them, the same cell (or
-one of equal cost) at the same cost, after a few hundred cells instead of every cell cheaper than
-the goal in every direction.
+one of equal cost) at the same cost, expanding the cells near its cheapest path (about 1,800 at
+the median on the 300-object benchmark map) instead of every cell cheaper than the goal in every
+direction (about 13,000).
 """
 
 from __future__ import annotations
