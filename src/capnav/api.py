@@ -174,7 +174,7 @@ class CapNav:
 
     def __init__(self, cmap: CapNavMap, *, embedder: str | TextEmbedder = "auto", embedder_path: str | Path | None
                  = None, verifier: str = "offline", retrieval: RetrievalConfig | None = None,
-                 planner: PlannerConfig | None = None, source: str | Path | None = None) -> None:
+                 planner: PlannerConfig | None = None, source: str | Path | None = None, fields: bool = True) -> None:
         if not isinstance(cmap, CapNavMap):
             raise InputError(f"CapNav wraps a CapNavMap, got {type(cmap).__name__} (use CapNav.open(path))")
         self.map = cmap
@@ -190,6 +190,9 @@ class CapNav:
         self._grid: tuple[OccupancyGrid, list[str]] | None = None
         self._frames: Any = None  # the frames a map was built from (for captioning views)
         self._without_voxels = False  # opened with voxels=False: save would lose them
+        #: Per-object fields (goal fields, walk fields) that make asks from new robot positions
+        #: lookups; False: every ask searches from the robot (the answers are the same).
+        self.fields = fields
 
     # -- opening, building, saving ----------------------------------------------------------------
     @classmethod
@@ -312,8 +315,10 @@ class CapNav:
         if self._retriever is None:
             from capnav.retrieval import create_verifier
 
-            self._retriever = Retriever(self.map, self.embedder, create_verifier(self._verifier_name),
-                                        self.retrieval_config)
+            r = Retriever(self.map, self.embedder, create_verifier(self._verifier_name), self.retrieval_config)
+            if not self.fields:
+                r.field_bytes = 0
+            self._retriever = r
         return self._retriever
 
     @property
@@ -333,7 +338,37 @@ class CapNav:
             from capnav.planning.sight import map_columns
 
             self._costmap = build_costmap(self.occupancy, self.planner_config, map_columns(self.map))
+            if not self.fields:
+                self._costmap.cache["no_fields"] = True
         return self._costmap
+
+    def prepare(self, stop: Any = None) -> str:
+        """Make every object's goal field and walk field ahead of the asks (a server does it on a
+        thread of its own once a map is loaded; the kernels release the GIL): afterwards an ask
+        from a robot position no ask used before costs a short search and lookups instead of
+        searches from the robot. Without it fields are made as objects are asked (on the second
+        ask). ``stop`` (a ``threading.Event``): stop early when set. Says what was made."""
+        from capnav.planning.goal import prepare_goal
+        from capnav.planning.sight import object_heights
+
+        if not self.fields or not self.map.objects:
+            return "no fields"
+        goals = walks = 0
+        floor = self.retriever.floor_distances()
+        for i, obj in enumerate(self.map.objects):
+            if stop is not None and stop.is_set():
+                break
+            try:
+                goals += prepare_goal(self.occupancy, obj.footprint, self.costmap, self.planner_config,
+                                      z_range=object_heights(obj))
+            except (NotFoundError, InputError):
+                pass
+            if floor is not None:
+                walks += floor.field(i) is not None
+        held = sum(0 if f is None else f.nbytes for f in list(self.costmap.cache.get("goal_field", {}).values()))
+        held += 0 if floor is None else floor.held
+        return (f"goal fields for {goals}, walk fields for {walks} of {len(self.map.objects)} objects, "
+                f"{held / 2**20:.0f} MB")
 
     def start_pose(self) -> tuple[tuple[float, float, float], str]:
         """The default start, as ``capnav navigate`` takes it: the map's last camera pose (x, y, yaw)

@@ -1,6 +1,8 @@
 """The bucket-queue walking distance gives the very floats of a heap-ordered Dijkstra (the routine
 it replaced, kept here in plain Python as the reference), with and without a distance limit, and
-walking distances to objects keep their order where it differs from the straight line."""
+walking distances to objects keep their order where it differs from the straight line. Walking
+distances to objects are exact (a + b sqrt 2 from the step counts): the reference counts steps
+too, and an object's walk field read at a robot's cell gives the float of the walk from the robot."""
 
 from __future__ import annotations
 
@@ -19,10 +21,13 @@ _MOVES = [(-1, -1, math.sqrt(2)), (-1, 0, 1.0), (-1, 1, math.sqrt(2)), (0, -1, 1
           (1, -1, math.sqrt(2)), (1, 0, 1.0), (1, 1, math.sqrt(2))]
 
 
-def heap_dijkstra(domain: np.ndarray, seeds: np.ndarray, limit: float) -> np.ndarray:
-    """The replaced routine: a binary heap, no closed set, cells past ``limit`` not expanded."""
+def heap_dijkstra(domain: np.ndarray, seeds: np.ndarray, limit: float, exact: bool = False) -> np.ndarray:
+    """The replaced routine: a binary heap, no closed set, cells past ``limit`` not expanded.
+    ``exact``: each distance is a + b sqrt 2 from its path's counts of straight (a) and diagonal
+    (b) steps, not summed step by step (the walking distances to objects)."""
     rows, cols = domain.shape
     dist = np.full((rows, cols), np.inf)
+    counts = np.zeros((rows, cols, 2), np.int64)
     heap: list[tuple[float, int, int]] = []
     for r, c in seeds:
         dist[r, c] = 0.0
@@ -34,9 +39,14 @@ def heap_dijkstra(domain: np.ndarray, seeds: np.ndarray, limit: float) -> np.nda
             continue
         for dr, dc, w in _MOVES:
             rr, cc = r + dr, c + dc
-            if 0 <= rr < rows and 0 <= cc < cols and domain[rr, cc] and d + w < dist[rr, cc]:
-                dist[rr, cc] = d + w
-                heapq.heappush(heap, (d + w, rr, cc))
+            if not (0 <= rr < rows and 0 <= cc < cols and domain[rr, cc]):
+                continue
+            a, b = counts[r, c] + ((0, 1) if dr and dc else (1, 0))
+            nd = float(a) + float(b) * math.sqrt(2) if exact else d + w
+            if nd < dist[rr, cc]:
+                dist[rr, cc] = nd
+                counts[rr, cc] = a, b
+                heapq.heappush(heap, (nd, rr, cc))
     return dist
 
 
@@ -101,7 +111,7 @@ def test_walking_order_differs_from_the_straight_line_and_matches_the_reference(
     line = np.hypot(*((los + his) / 2 - robot).T)
     assert np.argmin(line) == 0 and np.argmin(d) == 1
     rc = spec.to_cell(np.asarray(robot))
-    ref_field = heap_dijkstra(floor.domain, np.array([rc], np.int64), math.inf) * spec.resolution
+    ref_field = heap_dijkstra(floor.domain, np.array([rc], np.int64), math.inf, exact=True) * spec.resolution
     ref = np.array([box_min(ref_field, spec, lo, hi) for lo, hi in zip(los, his, strict=True)])
     np.testing.assert_array_equal(d, ref)
     assert floor.from_point(robot) is d  # cached per source cell
@@ -141,7 +151,8 @@ def test_floor_distances_give_the_floats_of_the_heap_dijkstra_and_the_per_box_lo
     for r, c in free[rng.choice(len(free), size=6, replace=False)]:
         xy = spec.to_world(np.array([r, c]))
         got = floor.from_point((float(xy[0]), float(xy[1])))
-        field = heap_dijkstra(floor.domain, np.array([spec.to_cell(xy)], np.int64), math.inf) * spec.resolution
+        field = heap_dijkstra(floor.domain, np.array([spec.to_cell(xy)], np.int64), math.inf,
+                              exact=True) * spec.resolution
         ref = np.array([box_min(field, spec, lo, hi, RING) for lo, hi in zip(los, his, strict=True)])
         np.testing.assert_array_equal(got, ref)
         finite += int(np.isfinite(ref).sum())
@@ -150,7 +161,7 @@ def test_floor_distances_give_the_floats_of_the_heap_dijkstra_and_the_per_box_lo
     field = heap_dijkstra(floor.domain, np.concatenate(
         [np.argwhere(np.ones((b[2] - b[0] + 1, b[3] - b[1] + 1), bool)) + b[:2]
          for b in (np.array(box_cells(spec, los[i], his[i])) for i in pair)
-         if b[2] >= b[0] and b[3] >= b[1]]).astype(np.int64), math.inf) * spec.resolution
+         if b[2] >= b[0] and b[3] >= b[1]]).astype(np.int64), math.inf, exact=True) * spec.resolution
     ref = np.array([box_min(field, spec, lo, hi, RING) for lo, hi in zip(los, his, strict=True)])
     np.testing.assert_array_equal(floor.from_objects(pair), ref)
     assert 0 < finite < 6 * len(los) and ring > 0  # unreached boxes, and one measured at its ring
@@ -194,3 +205,51 @@ def test_a_walk_stopped_once_some_objects_are_measured_gives_their_floats(seed: 
         np.testing.assert_array_equal(part.from_point(robot, rest)[rest], ref[rest])  # filled in from here
         np.testing.assert_array_equal(part.from_point(robot), ref)
     assert stopped > 0
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3, 4])
+def test_an_objects_walk_field_gives_the_floats_of_the_walk_from_the_robot(seed: int) -> None:
+    # The field walked once from an object's cells, read at a robot's cell, is the float a walk
+    # from the robot gives at that object (exact distances: the same from either end), so a
+    # ranking from a robot position no walk started from is a lookup per object; with every field
+    # made, with none (field_bytes 0) and with room for a few (the least recently used go), from
+    # many robots, asking for some objects, one of them never reached (then the walk runs on).
+    from capnav.core.geodesic import NO_WALK, walk_field, walk_value
+
+    rng = np.random.default_rng(50 + seed)
+    spec = GridSpec(0.0, 0.0, 0.1, 30, 45)
+    dom = rooms_with_doors(rng, 30, 45)
+    dom[18:27, 30:39] = False
+    dom[19:26, 31:38] = True
+    occ = OccupancyGrid(spec, np.where(dom, FREE, OCCUPIED).astype(np.uint8))
+    los = rng.uniform([-0.4, -0.4], [4.4, 2.9], (30, 2))
+    his = los + rng.uniform(0.05, 0.6, (30, 2))
+    los[-1], his[-1] = spec.to_world(np.array([22, 35])), spec.to_world(np.array([24, 36]))  # in the closed room
+    plain = FloorDistances(occ, los, his, cache_size=0, field_bytes=0)
+    full = FloorDistances(occ, los, his, cache_size=0)
+    boxes = [box_cells(spec, lo, hi) for lo, hi in zip(los, his, strict=True)]
+    assert full.prepare() == sum(b[2] >= b[0] and b[3] >= b[1] for b in boxes)  # an empty box has no field
+    few = FloorDistances(occ, los, his, cache_size=0, field_bytes=3 * spec.rows * spec.cols * 4)
+    free = np.argwhere(plain.domain)
+    looked = 0
+    for k, (r, c) in enumerate(free[rng.choice(len(free), size=12, replace=False)]):
+        xy = spec.to_world(np.array([r, c]))
+        robot = (float(xy[0]), float(xy[1]))
+        among = rng.choice(len(los) - 1, size=1 + k % 5, replace=False)
+        if k % 4 == 3:
+            among = np.append(among, len(los) - 1)
+        ref = plain.from_point(robot, among)
+        for floor in (full, few, few):  # few: its second ranking may make the fields it lacks
+            got = floor.from_point(robot, among)
+            np.testing.assert_array_equal(got, ref)  # nan where ref is nan, the same floats elsewhere
+        box = boxes[among[0]]
+        f = full.field(int(among[0]), make=False)
+        if f is None:
+            continue
+        if f[r * spec.cols + c] != NO_WALK:
+            assert walk_value(int(f[r * spec.cols + c])) * spec.resolution == ref[among[0]]
+            looked += 1
+        seeds = np.argwhere(np.ones((box[2] - box[0] + 1, box[3] - box[1] + 1), bool)) + box[:2]
+        np.testing.assert_array_equal(walk_field(full._base, spec.cols, seeds.astype(np.int64)), f)
+    assert looked >= 4
+    assert few._held <= 3 * spec.rows * spec.cols * 4 and len(few._fields) <= 3

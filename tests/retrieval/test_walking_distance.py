@@ -79,3 +79,22 @@ def test_no_cache_walks_again_and_a_negative_size_is_refused(scene) -> None:
     assert a is not b and np.array_equal(a, b)
     with pytest.raises(InputError, match="cache_size must be >= 0"):
         FloorDistances(cmap.occupancy, los, his, cache_size=-1)
+
+
+def test_rankings_read_off_walk_fields_are_those_of_the_walks(scene) -> None:
+    # Every object's walk field made ahead (as a server does at load): "closest" and "farthest"
+    # from robots no walk started from give the answers, reasons and distances of the walks.
+    cmap, emb = scene
+    fields, walks = Retriever(cmap, emb), Retriever(cmap, emb)
+    walks.field_bytes = 0
+    floor = fields.floor_distances()
+    assert floor is not None and floor.prepare() == len(cmap.objects)
+    rng = np.random.default_rng(4)
+    for text in ("the nearest plant to me", "the farthest plant from me", "the closest seat", "the plant"):
+        for _ in range(6):
+            robot = (float(rng.uniform(0.0, 9.0)), float(rng.uniform(0.0, 6.0)))
+            a, b = fields.query(text, robot_xy=robot), walks.query(text, robot_xy=robot)
+            assert (a.chosen.id if a.chosen else None) == (b.chosen.id if b.chosen else None)
+            assert a.reason == b.reason and a.distance_m == b.distance_m and a.details == b.details
+            assert [o.id for o, _ in a.ranked] == [o.id for o, _ in b.ranked]
+    assert floor.held > 0 and walks.floor_distances().held == 0

@@ -56,6 +56,9 @@ def register(app: typer.Typer) -> None:
         verifier: Annotated[str, typer.Option(help="offline | none | gemini | openai | hf-local")] = "offline",
         embedder: Annotated[str, typer.Option(help="auto (the map's model) or a backend name")] = "auto",
         embedder_path: Annotated[Path | None, typer.Option(help="local model folder for other embedders")] = None,
+        fields: Annotated[bool, typer.Option(help="make each object's goal and walk fields once a worker is up "
+                                                  "(about 1 MB an object per worker): asks from new robot positions "
+                                                  "are then lookups, with the same answers")] = True,
     ) -> None:
         """Serve maps: a page to ask them in words and see the answer on the map, plus a JSON API.
         SIGHUP or POST /api/reload re-reads map files replaced on disk; SIGTERM finishes the asks
@@ -88,7 +91,7 @@ def register(app: typer.Typer) -> None:
         cfg = ServeConfig(max_body=max_body, rate=rate, burst=burst, workers=workers, queue=queue,
                           time_limit=time_limit, body_timeout=body_timeout, token=token, access_log=access_log,
                           load_in_background=True, pool=pool)
-        opts = AskOptions(embedder, embedder_path, verifier)
+        opts = AskOptions(embedder, embedder_path, verifier, fields)
         app = create_app(list(map_paths), cfg, opts)
         handler = logging.StreamHandler(sys.stderr)
         handler.setFormatter(logging.Formatter("%(asctime)s %(message)s", "%H:%M:%S"))

@@ -7,7 +7,10 @@ buckets before k are done (Dinitz's observation). The cells of one bucket are th
 any order, each once, with no heap: a whole-grid search costs a few array reads per cell. The
 values are the same floats a heap-ordered Dijkstra gives (each cell keeps the smallest
 ``d(neighbour) + step`` over its expanded neighbours, and rounding is monotone), so answers do
-not move.
+not move. Walking distances to objects are exact (``a + b sqrt 2`` from a walk's step counts,
+``_walk_until``): the same float whichever end the walk starts from, so an object's
+:func:`walk_field`, walked once from the object, answers a robot anywhere with the float a walk
+from the robot gives.
 
 Why one array: the distances live on the grid padded by a border, with ``BLOCKED`` (-1) in
 unwalkable and border cells, so a neighbour is tested with the one read ``d + step < dist[v]``
@@ -47,19 +50,29 @@ def walk_base(domain: NDArray[np.bool_]) -> NDArray[np.float64]:
 @njit(cache=True, nogil=True)
 def _walk(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int64], limit: float) -> NDArray[np.float64]:
     """Cells from the nearest seed, on a copy of ``base`` (padded, ``cols`` + 2 wide)."""
-    return _walk_until(base, cols, seeds, limit, np.zeros(0, np.uint8), np.zeros((0, 4), np.int64))[0]
+    return _walk_until(base, cols, seeds, limit, np.zeros(0, np.uint8), np.zeros((0, 4), np.int64), False)[0]
 
 
 @njit(cache=True, nogil=True)
 def _walk_until(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int64], limit: float,
-                mark: NDArray[np.uint8], want: NDArray[np.int64]) -> tuple[NDArray[np.float64], bool]:
+                mark: NDArray[np.uint8], want: NDArray[np.int64], exact: bool
+                ) -> tuple[NDArray[np.float64], bool, NDArray[np.int32]]:
     """``_walk``, stopped once a cell of every box of ``want`` (r0, c0, r1, c1 inclusive, grid
     cells; ``mark`` is 1 on their padded cells, or empty for no stop) is expanded; whether it ran
     to the end. When the last box's first cell is expanded at ``d`` in bucket k, every cell below
     k + 1 already holds its final distance (set from buckets before k) and every other cell holds
-    at least k + 1 > ``d``: each box's minimum over ``dist`` is then final."""
+    at least k + 1 > ``d``: each box's minimum over ``dist`` is then final.
+
+    ``exact``: each distance is ``a + b * sqrt 2`` computed from its walk's counts of straight
+    (a) and diagonal (b) steps (returned as ``diag``, b per padded cell), not summed step by step:
+    the float then depends on the counts only, so a walk from A to B and one from B to A give
+    the same float (sums of the same steps in another order may differ in their last bit). Two
+    different counts never tie and keep their order as floats: a + b sqrt 2 = a' + b' sqrt 2
+    only when a = a', b = b' (sqrt 2 is irrational), and on any grid that fits in memory the
+    gap between two such values is far above float64's rounding."""
     w = cols + 2
     dist = base.copy()
+    diag = np.zeros(base.shape[0] if exact else 0, np.int32)
     left = want.shape[0]
     done = np.zeros(left, np.bool_)
     # Three buckets suffice: a cell expanded from bucket k lands in k + 1 or k + 2 (steps < 2); a
@@ -97,7 +110,9 @@ def _walk_until(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int64], 
                         done[i] = True
                         left -= 1
                 if left == 0:
-                    return dist, False
+                    return dist, False, diag
+            bu = diag[u] if exact else 0
+            au = int(np.rint(du - bu * _SQRT2)) if exact else 0
             for m in range(8):
                 if m == 0:
                     v, nd = u - w - 1, du + _SQRT2
@@ -116,7 +131,12 @@ def _walk_until(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int64], 
                 else:
                     v, nd = u + w + 1, du + _SQRT2
                 dv = dist[v]
+                if exact:
+                    bv = bu + (1 if m == 0 or m == 2 or m == 5 or m == 7 else 0)
+                    nd = float(au + bu + 1 - bv) + float(bv) * _SQRT2
                 if nd < dv:
+                    if exact:
+                        diag[v] = bv
                     b = int(nd)
                     if dv == np.inf or int(dv) != b:  # not in nd's bucket yet
                         if b == k1:
@@ -129,7 +149,7 @@ def _walk_until(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int64], 
         cur, nx1, nx2 = nx1, nx2, cur
         fc, f1, f2 = f1, f2, 0
         k += 1
-    return dist, True
+    return dist, True, diag
 
 
 @njit(cache=True, nogil=True)
@@ -166,8 +186,9 @@ def walk_box_minima(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int6
                     grown: NDArray[np.int64], scale: float, grow: float) -> NDArray[np.float64]:
     """``box_minima`` of the walk from ``seeds`` on ``base`` (:func:`walk_base` of a grid ``cols``
     wide) times ``scale``, without making the (rows, cols) field: the same floats, since scaling by
-    a positive number keeps the minimum (rounding is monotone)."""
-    dist = _walk(base, cols, seeds, np.inf)
+    a positive number keeps the minimum (rounding is monotone). Distances are exact (see
+    ``_walk_until``): the floats :func:`walk_field` gives from the box back to the seed."""
+    dist = _walk_until(base, cols, seeds, np.inf, np.zeros(0, np.uint8), np.zeros((0, 4), np.int64), True)[0]
     w = cols + 2
     out = np.full(boxes.shape[0], np.inf)
     for i in range(boxes.shape[0]):
@@ -205,7 +226,7 @@ def walk_box_minima_of(base: NDArray[np.float64], cols: int, seeds: NDArray[np.i
                 mark[o + c] = 1
     if m < among.shape[0]:  # an empty box is reached only through its ring: the whole walk
         m = 0
-    dist, whole = _walk_until(base, cols, seeds, np.inf, mark, want[:m])
+    dist, whole, _ = _walk_until(base, cols, seeds, np.inf, mark, want[:m], True)
     out = np.full(boxes.shape[0], np.nan)
     for j in range(boxes.shape[0] if whole else 0):
         out[j] = np.inf
@@ -219,6 +240,41 @@ def walk_box_minima_of(base: NDArray[np.float64], cols: int, seeds: NDArray[np.i
             if best < np.inf:
                 out[i] = best * scale + grow
     return out
+
+
+#: A cell of a walk field that no walk from its seeds reaches.
+NO_WALK = np.uint32(0xFFFFFFFF)
+
+
+@njit(cache=True, nogil=True)
+def walk_field(base: NDArray[np.float64], cols: int, seeds: NDArray[np.int64]) -> NDArray[np.uint32]:
+    """The exact walk from ``seeds`` (an object's cells) to every cell of the grid, kept as its
+    step counts: ``a << 16 | b`` (a straight, b diagonal steps; the distance is
+    :func:`walk_value`), ``NO_WALK`` where no walk reaches. Walks are symmetric, so the value
+    at a robot's cell is the walk from the robot to the nearest seed: the float
+    :func:`walk_box_minima_of` gives. Empty when a count does not fit in 16 bits."""
+    w = cols + 2
+    rows = base.shape[0] // w - 2
+    dist, _, diag = _walk_until(base, cols, seeds, np.inf, np.zeros(0, np.uint8), np.zeros((0, 4), np.int64), True)
+    out = np.empty(rows * cols, np.uint32)
+    for r in range(rows):
+        o = (r + 1) * w + 1
+        for c in range(cols):
+            d = dist[o + c]
+            if d >= 0.0 and d < np.inf:
+                b = diag[o + c]
+                a = int(np.rint(d - b * _SQRT2))
+                if a >= 65535 or b >= 65535:
+                    return np.empty(0, np.uint32)
+                out[r * cols + c] = (np.uint32(a) << np.uint32(16)) | np.uint32(b)
+            else:
+                out[r * cols + c] = NO_WALK
+    return out
+
+
+def walk_value(packed: int) -> float:
+    """The distance (cells) of a :func:`walk_field` entry: a + b sqrt 2, as the walk computes it."""
+    return float(packed >> 16) + float(packed & 0xFFFF) * _SQRT2
 
 
 @njit(cache=True, nogil=True)
@@ -241,4 +297,5 @@ def box_minima(field: NDArray[np.float64], boxes: NDArray[np.int64], grown: NDAr
     return out
 
 
-__all__ = ["BLOCKED", "box_minima", "grid_geodesic", "walk_base", "walk_box_minima", "walk_box_minima_of"]
+__all__ = ["BLOCKED", "NO_WALK", "box_minima", "grid_geodesic", "walk_base", "walk_box_minima", "walk_box_minima_of",
+           "walk_field", "walk_value"]

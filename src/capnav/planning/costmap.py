@@ -100,6 +100,9 @@ def mark_blocked(costmap: Costmap, xy: NDArray[np.floating], radius: float, conf
     win[newly] = np.inf
     costmap.cache.pop("goal_around", None)  # goal selection's per-object windows read the cells marked here
     costmap.cache.pop("goal_pose", None)  # and the poses it chose on the weights before the mark
+    costmap.cache.pop("goal_field", None)  # and the fields of the cells that passed the goal rule
+    costmap.cache.pop("goal_field_asked", None)
+    costmap.cache.pop("goal_walk_base", None)  # the weights those fields were walked on
     return int(newly.sum())
 
 

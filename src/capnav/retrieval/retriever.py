@@ -84,6 +84,8 @@ class Retriever:
         self.grid = occ.spec if occ is not None else self._grid_from_objects()
         self.cells = self.grid.to_cell(np.array([o.position[:2] for o in self.objects]))
         self._floor: FloorDistances | None = None  # walking distances, built on the first "closest"
+        #: Bytes of walk fields the walking distances keep (None: ``spatial.FIELD_BYTES``; 0: none).
+        self.field_bytes: int | None = None
         self._readings: OrderedDict[str, list[ParsedQuery]] = OrderedDict()
         # An object's category: the caption's name when it is a vocabulary word, else its label.
         self.cats = []
@@ -142,7 +144,7 @@ class Retriever:
         if self._floor is None:
             los = np.array([o.extent_min[:2] for o in self.objects], dtype=np.float64)
             his = np.array([o.extent_max[:2] for o in self.objects], dtype=np.float64)
-            self._floor = FloorDistances(occ, los, his)
+            self._floor = FloorDistances(occ, los, his, field_bytes=self.field_bytes)
         return self._floor
 
     def read_goals(self, instruction: str) -> list[ParsedQuery]:

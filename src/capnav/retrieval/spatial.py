@@ -11,6 +11,8 @@ the map's floor (paper eq. 17's straight grid distance stays an option, ``Retrie
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -28,6 +30,13 @@ RING = 0.3
 #: from where it stands, or the goal sequence after it, then pays no walk.
 CACHE_SOURCES = 1024
 CACHE_BYTES = 8 << 20
+#: Bytes of walk fields (one per object, :func:`capnav.core.geodesic.walk_field`) a
+#: ``FloorDistances`` keeps: 4 bytes a cell, 720 kB per object on a 24 x 18 m floor of 5 cm cells,
+#: so a 300-object map's fields fit. 0: none.
+FIELD_BYTES = 256 << 20
+#: Walk fields made per ranking that needs them (the rest on later rankings, or ahead by
+#: ``prepare``): a ranking of twenty chairs does not pay twenty whole walks at once.
+FIELDS_PER_ASK = 2
 
 
 def segment_distance(p: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
@@ -93,7 +102,7 @@ class FloorDistances:
     (``cache_size`` sources, default ``CACHE_SOURCES`` within ``CACHE_BYTES``; 0: none)."""
 
     def __init__(self, occ: OccupancyGrid, los: NDArray[np.float64], his: NDArray[np.float64],
-                 cache_size: int | None = None) -> None:
+                 cache_size: int | None = None, field_bytes: int | None = None) -> None:
         self.spec = occ.spec
         self.los = np.asarray(los, dtype=np.float64).reshape(-1, 2)
         self.his = np.asarray(his, dtype=np.float64).reshape(-1, 2)
@@ -117,6 +126,84 @@ class FloorDistances:
             raise InputError(f"FloorDistances cache_size must be >= 0 (0: no cache), got {cache_size}")
         self._cache: dict[tuple[int, ...], NDArray[np.float64]] = {}
         self._size = cache_size
+        # Walk fields: per object, the exact walk from its cells to every cell (walks are
+        # symmetric), so a ranking from a robot no walk started from is a lookup per object.
+        self._fields: dict[int, NDArray[np.uint32] | None] = {}
+        self._field_bytes = FIELD_BYTES if field_bytes is None else int(field_bytes)
+        self._ranked: dict[int, int] = {}  # rankings each object was asked in without a field
+        self._held = 0  # bytes of the kept fields
+        self._lock = threading.Lock()
+
+    # -- walk fields -------------------------------------------------------------------------
+    def field(self, i: int, make: bool = True) -> NDArray[np.uint32] | None:
+        """Object ``i``'s walk field (made now unless ``make`` is False; None when it has none:
+        no cell, a walk too long for its counts, or no room in ``field_bytes``)."""
+        with self._lock:
+            if i in self._fields:
+                hit = self._fields.pop(i)
+                self._fields[i] = hit  # the most recently used
+                return hit
+        if not make or self._field_bytes <= 0:
+            return None
+        from capnav.core.geodesic import walk_field
+
+        r0, c0, r1, c1 = (int(v) for v in self._boxes[i])
+        made: NDArray[np.uint32] | None = None
+        if r1 >= r0 and c1 >= c0:
+            rr, cc = np.mgrid[r0:r1 + 1, c0:c1 + 1]
+            f = walk_field(self._base, self.spec.cols, np.stack([rr.ravel(), cc.ravel()], axis=1).astype(np.int64))
+            made = f if len(f) else None
+        size = 0 if made is None else made.nbytes
+        with self._lock:  # a server makes fields on a thread of its own while asks read them
+            if i in self._fields:
+                return self._fields[i]
+            while self._fields and self._held + size > self._field_bytes:
+                gone = self._fields.pop(next(iter(self._fields)))  # the least recently used
+                self._held -= 0 if gone is None else gone.nbytes
+            if size <= self._field_bytes:
+                self._fields[i] = made
+                self._held += size
+        return made
+
+    def _looked_up(self, rc: tuple[int, int], among: NDArray[np.intp]) -> NDArray[np.float64] | None:
+        """``walk_box_minima_of`` from the cell ``rc`` for ``among`` read off their walk fields: the
+        same floats (exact walks, :func:`capnav.core.geodesic.walk_value`), or None when an
+        object has no field yet (at most ``FIELDS_PER_ASK`` are made, for objects ranked before)
+        or the walk would not stop at them (one is never reached)."""
+        from capnav.core.geodesic import NO_WALK, walk_value
+
+        if self._field_bytes <= 0 or not self.domain[rc]:
+            return None
+        fields = [self.field(int(i), make=False) for i in among]
+        made = 0
+        for k, i in enumerate(among):
+            if fields[k] is None and int(i) not in self._fields:
+                n = self._ranked[int(i)] = self._ranked.get(int(i), 0) + 1
+                if n >= 2 and made < FIELDS_PER_ASK:
+                    fields[k] = self.field(int(i))
+                    made += 1
+        if any(f is None for f in fields):
+            if len(self._ranked) > 8 * len(self._boxes) + 64:
+                self._ranked.clear()
+            return None
+        at = rc[0] * self.spec.cols + rc[1]
+        out = np.full(len(self._boxes), np.nan)
+        for k, i in enumerate(among):
+            v = int(fields[k][at])  # type: ignore[index]
+            if v == int(NO_WALK):
+                return None  # the walk would run on to the end and measure every object
+            out[i] = walk_value(v) * self.spec.resolution
+        return out
+
+    @property
+    def held(self) -> int:
+        """Bytes of the walk fields kept."""
+        return self._held
+
+    def prepare(self) -> int:
+        """Make every object's walk field (a server does it at load, off its asks); how many
+        objects have one."""
+        return sum(self.field(i) is not None for i in range(len(self._boxes)))
 
     def _per_object(self, key: tuple[int, ...], los: NDArray[np.float64], his: NDArray[np.float64],
                     among: NDArray[np.intp] | None = None) -> NDArray[np.float64]:
@@ -125,7 +212,13 @@ class FloorDistances:
         missing = None if hit is None else np.isnan(hit if among is None else hit[among])
         if hit is None or (missing is not None and missing.any()):
             seeds = box_seeds(self.domain, self.spec, los, his)
-            if len(seeds) == 0:
+            ask = None if among is None else np.asarray(among if hit is None else among[missing], dtype=np.int64)
+            looked = None
+            if key[0] == "point" and ask is not None and len(ask) and len(seeds) == 1:
+                looked = self._looked_up((int(seeds[0, 0]), int(seeds[0, 1])), ask)
+            if looked is not None:
+                new = looked
+            elif len(seeds) == 0:
                 new = np.full(len(self._boxes), np.inf)
             elif among is None:
                 from capnav.core.geodesic import walk_box_minima
@@ -135,7 +228,7 @@ class FloorDistances:
             else:
                 from capnav.core.geodesic import walk_box_minima_of
 
-                ask = np.asarray(among if hit is None else among[missing], dtype=np.int64)
+                assert ask is not None
                 new = walk_box_minima_of(self._base, self.spec.cols, seeds, self._boxes, self._grown,
                                          self.spec.resolution, RING, ask)
             if hit is not None:  # what an earlier, partial walk from here measured stays

@@ -36,6 +36,9 @@ class AskOptions:
     embedder: str | TextEmbedder = "auto"
     embedder_path: str | Path | None = None
     verifier: str = "offline"
+    #: Per-object goal and walk fields (``CapNav.prepare``), made by each worker on a thread of its
+    #: own once it has warmed up: asks from robot positions no ask used before are then lookups.
+    fields: bool = True
 
     @property
     def shared_instance(self) -> bool:
@@ -117,7 +120,7 @@ class ServedMap:
         thread's embedder; the map itself is read-only and shared."""
         n = self.nav
         return CapNav(n.map, embedder=embedder, verifier=self.options.verifier, retrieval=n.retrieval_config,
-                      planner=n.planner_config, source=self.path)
+                      planner=n.planner_config, source=self.path, fields=self.options.fields)
 
     def ref(self) -> MapRef:
         """How a worker process names this map (only a map opened from a file has one)."""
@@ -172,6 +175,7 @@ class WorkerState:
         self.embedders: dict[tuple[Any, ...], TextEmbedder] = {}
         self.navs: dict[str, tuple[int, CapNav]] = {}
         self.opened: dict[str, ServedMap] = {}
+        self.preparing: dict[str, tuple[threading.Thread, threading.Event]] = {}
 
     def served(self, m: ServedMap | MapRef) -> ServedMap:
         """The map a job names: the server's own object (worker threads), or in a worker process
@@ -194,7 +198,23 @@ class WorkerState:
         nav = m.worker_nav(emb)
         if have is None or have[0] < m.version:  # a request begun before a reload gets a nav of its own
             self.navs[m.name] = (m.version, nav)
+            if have is not None:  # a reloaded map: its fields are made again
+                self.prepare(m.name, nav)
         return nav
+
+    def prepare(self, name: str, nav: CapNav) -> None:
+        """Make ``nav``'s per-object fields on a daemon thread of their own (the kernels release
+        the GIL; the asks meanwhile search as without fields), stopping the one of the map's
+        previous version."""
+        if not nav.fields:
+            return
+        old = self.preparing.pop(name, None)
+        if old is not None:
+            old[1].set()
+        stop = threading.Event()
+        t = threading.Thread(target=_prepare, args=(nav, stop), name=f"capnav-fields-{name}", daemon=True)
+        self.preparing[name] = (t, stop)
+        t.start()
 
     def warm(self, m: ServedMap) -> None:
         """Load the embedder, build the costmap and run the planner once, so the first real ask
@@ -208,4 +228,12 @@ class WorkerState:
             if m.robot0 is not None:
                 nav.plan(m.robot0, o.id)
         except CapNavError:
-            pass  # an uncaptioned map still serves its picture; its asks say why they cannot be answered
+            return  # an uncaptioned map still serves its picture; its asks say why they cannot be answered
+        self.prepare(m.name, nav)
+
+
+def _prepare(nav: CapNav, stop: threading.Event) -> None:
+    try:
+        nav.prepare(stop)
+    except CapNavError:
+        pass  # the asks make what they need as they go
