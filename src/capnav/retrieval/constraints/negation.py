@@ -7,7 +7,9 @@ import numpy as np
 
 from capnav.core.errors import InputError
 from capnav.retrieval.constraints.base import CONTRADICTED, Evidence, RankingConstraint, RankState, ranking
+from capnav.retrieval.constraints.relation import BIN_M, landmark_instances
 from capnav.retrieval.query import ParsedQuery, parse_instruction
+from capnav.retrieval.query.mapping import negated_relation
 
 
 @ranking
@@ -53,6 +55,18 @@ class Negation(RankingConstraint):
         named = pool[weights[pool] >= 1.0]
         ref = named if len(named) else pool
         for phrase in q.negations:
+            rel = negated_relation(phrase)
+            if rel is not None:
+                # "the lamp that's not beside the bed" presumes one is: the candidates nearest
+                # to the landmark (the relation's quarter-metre bin) are that one.
+                anchors = landmark_instances(st, rel[1], rel[2])
+                if len(anchors):
+                    gap = np.where(pool[:, None] == anchors[None, :], np.inf, r.scene.gap[np.ix_(pool, anchors)])
+                    g = gap.min(axis=1)
+                    if np.isfinite(g).any():
+                        for i in pool[g <= g.min() + BIN_M]:
+                            out.setdefault(int(i), phrase)
+                continue
             try:
                 nq = parse_instruction(phrase)
             except InputError:

@@ -21,9 +21,15 @@ def landmarks(st: RankState, second: bool = False) -> NDArray[np.intp]:
     """The landmark's instances (the second landmark's of "between" with ``second``): of its
     category, and when its phrase says a colour, a room or a shape, only the instance(s) that fit
     best ("the yellow lamp", "the cactus")."""
-    r, q, notes = st.r, st.q, st.notes
+    q = st.q
     category, phrase = (q.anchor2_category, q.anchor2_phrase) if second else (q.anchor_category, q.anchor_phrase)
     assert category is not None
+    return landmark_instances(st, category, phrase)
+
+
+def landmark_instances(st: RankState, category: str, phrase: str | None) -> NDArray[np.intp]:
+    """The instances of ``category`` that a landmark's ``phrase`` ("the yellow lamp") picks."""
+    r, notes = st.r, st.notes
     anchors = r.of_category(category)
     if len(anchors) < 2 or not phrase:
         return anchors

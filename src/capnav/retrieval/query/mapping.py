@@ -229,6 +229,20 @@ def _clause_landmark(q: ParsedQuery, head: str) -> str:
     return " ".join(words[: span[1]])
 
 
+def negated_relation(phrase: str) -> tuple[str, str, str] | None:
+    """(relation, landmark category, landmark phrase) when a negated phrase is a relation to a
+    landmark the vocabulary names ("beside the bed", "next to the white counter"), else None."""
+    low = phrase.lower().strip()
+    for rel in sorted(_RELATIONS, key=len, reverse=True):
+        if low.startswith(rel + " "):
+            rest = low[len(rel):].split()
+            while rest and rest[0] in _DETERMINERS:
+                rest = rest[1:]
+            cat, _, _ = _find_category(rest)
+            return None if cat is None else (rel, cat, " ".join(rest))
+    return None
+
+
 def _split_alternatives(words: list[str]) -> list[list[str]]:
     """"purple or orange", "red nor blue", "the white or the grey one": one negated phrase per
     alternative, so each is excluded on its own (a phrase is excluded only when all of it fits)."""
@@ -248,6 +262,12 @@ def _negations(q: ParsedQuery, head: str) -> str:
     out = head
     for m in list(_NEGATION.finditer(head))[::-1]:
         words = m.group("neg").split()
+        if negated_relation(" ".join(words)) is not None:
+            # "the lamp that's not beside the bed": the bed is the excluded relation's landmark,
+            # not the target; the phrase is excluded whole (``constraints.negation``).
+            out = out[: m.start()] + " " + out[m.end():]
+            q.negations.append(" ".join(words))
+            continue
         cat, span, _ = _find_category(words)
         if cat is not None and span is not None:
             out = out[: m.start()] + " " + " ".join(words[span[0]:span[1]]) + " " + out[m.end():]
