@@ -15,6 +15,7 @@ from capnav.retrieval.query import BETWEEN, END_OF, ROOM_WITH, ParsedQuery, pars
 from capnav.retrieval.spatial import end_distance, has_long_axis, segment_distance
 
 BIN_M = 0.25  # distances closer than this are a tie on the relation
+LEFT_OF, RIGHT_OF = "left of", "right of"
 
 
 def landmarks(st: RankState, second: bool = False) -> NDArray[np.intp]:
@@ -116,7 +117,24 @@ class Relation(RankingConstraint):
             far = q.proximity == "farthest"
             st.group_keys.append(-centre if far else centre)
             st.predicate = f"{q.proximity} to the {q.anchor_category}"
+        elif q.relation in (LEFT_OF, RIGHT_OF) and st.robot_xy is not None:
+            # "the chair to the left of the desk", as the speaker sees it (from the robot): those
+            # beside the landmark (within the captions' "next to") on that side of the line from
+            # the robot through it first, then by the gap.
+            near = anchors[np.argmin(np.where(same, np.inf, r.scene.gap[np.ix_(pool, anchors)]), axis=1)]
+            view = xy[near] - np.asarray(st.robot_xy, dtype=np.float64)
+            off = xy[pool] - xy[near]
+            cross = view[:, 0] * off[:, 1] - view[:, 1] * off[:, 0]  # > 0: on the left
+            on_side = (cross > 0) if q.relation == LEFT_OF else (cross < 0)
+            beside = on_side & (gap <= r.scene.config.next_to_distance)
+            st.values["on that side, seen from the robot"] = beside.astype(np.float64)
+            st.group_keys.append(-beside.astype(np.float64))
+            st.group_keys.append(np.round(gap / BIN_M))
+            st.predicate = f"{q.relation} the {q.anchor_category}"
         else:
+            if q.relation in (LEFT_OF, RIGHT_OF):
+                st.notes.append(f"'{q.relation}' needs a viewpoint (a robot position): ordered by the gap "
+                                f"to the {q.anchor_category} alone")
             key = np.round(gap / BIN_M)  # quarter-metre bins, attributes break ties
             if q.purpose is not None and is_placing(q.purpose):
                 # "somewhere by the bed to put my glass": every surface serves a thing put down,

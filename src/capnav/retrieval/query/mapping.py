@@ -155,7 +155,7 @@ def _place_landmark(q: ParsedQuery, head: str) -> str:
     if found is None or found[2]:
         return head
     rel = m.group("rel")
-    q.relation = "next to" if rel in ("besides", "beside", "by", "close to", "alongside") else rel
+    q.relation = relation_name(rel)
     q.anchor_category, q.anchor_phrase = found[0], found[1]
     return (head[: m.start("mid")] + head[m.end("mid"):]).strip()
 
@@ -181,7 +181,7 @@ def _activity_landmark(q: ParsedQuery, head: str, embedder: TextEmbedder | None)
     if best is None:
         return head
     rel = m.group("rel")
-    q.relation = "next to" if rel in ("besides", "beside", "by", "close to", "alongside") else rel
+    q.relation = relation_name(rel)
     q.anchor_category, q.anchor_phrase = best, best
     q.notes.append(f"'where {m.group('who')} {m.group('act')}' is read as the {best} (what serves it)")
     return (head[: m.start()] + " " + head[m.end():]).strip()
@@ -227,6 +227,17 @@ def _clause_landmark(q: ParsedQuery, head: str) -> str:
     q.anchor_category = acat
     q.anchor_phrase = " ".join(anchor_words)
     return " ".join(words[: span[1]])
+
+
+def relation_name(rel: str) -> str:
+    """The relation a phrase says: "beside", "by", "close to" are "next to"; "on the left-hand side
+    of", "to the left of" are "left of" (and right); the others as said."""
+    if rel in ("besides", "beside", "by", "close to", "alongside"):
+        return "next to"
+    for side in ("left", "right"):
+        if rel.endswith(" of") and side in rel.split() + rel.replace("-", " ").split():
+            return f"{side} of"
+    return rel
 
 
 def negated_relation(phrase: str) -> tuple[str, str, str] | None:
@@ -409,7 +420,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                     head = head[:m.start()] + " " + m.group(1)
                     break
                 if cat is not None:
-                    q.relation = "next to" if rel in ("besides", "beside", "by", "close to", "alongside") else rel
+                    q.relation = relation_name(rel)
                     q.anchor_category = cat
                     q.anchor_phrase = m.group(1)
                     head = head[:m.start()]

@@ -445,7 +445,7 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
         if t.text.lower() in _GENERIC and t.pos_ in ("NOUN", "PRON") and not any(s <= t.i < e for _, s, e, _ in cands):
             cands.append(((int(_is_landmark(t)), _depth(t), 1, t.i), t.i, t.i + 1, None))
     for t in doc:
-        if _is_side(t):
+        if _is_side(t) and not _of_landmark(t):
             g.side = _SIDES[t.text.lower()]
     for s, e, room in rooms:
         gov = _governor(_span_head(doc, s, e))
@@ -512,7 +512,8 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
     # "to your left", "on the right-hand side": a side, not an attribute.
     for t in doc:
         if _is_side(t):
-            keep -= {j for i in _side_phrase(t) for j in _word_of(doc, doc[i])}
+            if not _of_landmark(t):  # "to the left of the desk" is a relation (the mapping's)
+                keep -= {j for i in _side_phrase(t) for j in _word_of(doc, doc[i])}
         elif t.text.lower() in _SIDES:
             keep -= {t.i}  # "right next to the bed": an intensifier, no side and no attribute
     # An attribute word the parse does not attach to the head, to a landmark or to a stand-in for
@@ -586,6 +587,13 @@ def _side_phrase(t: Token) -> set[int]:
     if top.dep_ == "pobj" and top.head.pos_ == "ADP":
         out.add(top.head.i)
     return out
+
+
+def _of_landmark(t: Token) -> bool:
+    """Whether the side word ``t`` says a side of a landmark ("to the left of the desk", "on the
+    right-hand side of the sofa"): its phrase goes on with "of"."""
+    end = max(_side_phrase(t))
+    return end + 1 < len(t.doc) and t.doc[end + 1].lower_ == "of"
 
 
 def _word_of(doc: Doc, t: Token) -> set[int]:

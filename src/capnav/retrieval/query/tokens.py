@@ -143,7 +143,11 @@ _RELATIONS = [END_OF, "in front of", "facing", "next to", "close to", "beside", 
               "opposite", "across from", "alongside", "against",
               # above or below the landmark: on the floor plan the two touch (ranked by the gap
               # between footprints, as "next to"); the thing hung over a sink is not the sink
-              "on top of", "above", "below", "underneath", "beneath", "under", "atop"]
+              "on top of", "above", "below", "underneath", "beneath", "under", "atop",
+              # a side of the landmark, as the speaker sees it ("the chair to the left of the desk")
+              *(f"{prep}{side} of" for side in ("left", "right", "left-hand side", "right-hand side", "left side",
+                                                "right side", "left hand side", "right hand side")
+                for prep in ("to the ", "on the ", "at the ", ""))]
 _MATERIALS = {"wooden", "wood", "leather", "fabric", "velvet", "metal", "glass", "marble", "plastic",
               "ceramic", "stainless", "steel", "laminate", "cotton", "acrylic", "paper", "terracotta", "chrome"}
 #: Every other material word WordNet has, spoken as the material the surface test knows
