@@ -556,6 +556,9 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
             sub = {t.i for t in c.subtree}
             if sub & named or any(doc[k].dep_ == "neg" or doc[k].lower_ in _NEGATIVE for k in sub):
                 continue
+            if any(doc[k].lower_ in ("one", "ones") and doc[k].dep_ == "pobj" for k in sub):
+                continue  # "from the green one": a stand-in for another of the target's kind, an object
+
             if any(attribute_word(doc[k].lower_) for k in sub):
                 keep -= sub
     # Rooms one comes from or passes through are not where the target stands.
