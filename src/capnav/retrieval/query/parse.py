@@ -410,7 +410,7 @@ def _asks(v: Token) -> bool:
         return True
     subj = [c for c in v.children if c.dep_ in ("nsubj", "nsubjpass", "expl")]
     if subj:
-        return len(subj) == 1 and subj[0].lower_ == "you" and v.tag_ == "VB" \
+        return any(c.lower_ == "you" for c in subj) and v.tag_ == "VB" \
             and any(c.dep_ == "aux" and c.lower_ in _ASK_MODALS for c in v.children)
     if v.tag_ not in ("VB", "VBP") or v.dep_ in _NOT_CLAUSE:
         return False
