@@ -148,3 +148,12 @@ def test_a_door_named_by_the_candidates_own_room_is_its_door(retriever: Retrieve
 @needs_spacy
 def test_a_door_of_the_room_in_a_parsed_sentence(retriever: Retriever) -> None:
     assert _answer(retriever, "the second bookshelf in from the doorway of the office") == 33
+
+
+@pytest.mark.parametrize(("text", "oid"), [
+    ("the bookshelf furthest from the corridor door", 32),
+    ("the plant furthest from the kitchen door", 22),
+    ("the bookshelf furthest away from the entrance to the office", 32),
+])
+def test_farthest_from_a_door_reverses_the_order_from_the_way_in(retriever: Retriever, text: str, oid: int) -> None:
+    assert _answer(retriever, text) == oid

@@ -142,7 +142,8 @@ class Route(RankingConstraint):
             if want:
                 where += f", on the {'left' if side[k] > 0 else 'right'}"
             st.report(self.kind, int(i), Evidence(self.kind, SUPPORTED, 1.0, where))
-        rank_key = np.where(known, dist, 1e9)
+        # "the bookshelf furthest from the office door": the order from the way in, reversed.
+        rank_key = np.where(known, -dist if q.proximity == "farthest" else dist, 1e9)
         if want:
             # The side first, then the order met from the way in.
             st.group_keys.append(-(side == want).astype(np.float64))
