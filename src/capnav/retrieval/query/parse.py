@@ -462,9 +462,12 @@ def _request_clause(doc: Doc, mentions: list[tuple[int, int, str]]) -> set[int] 
     for v in reversed(doc):
         if not _asks(v):
             continue
-        ask = {t.i for t in v.subtree}
-        for c in v.children:
-            if c.dep_ in _STORY_DEPS and c.i < v.i and _tells(c):
+        # "pop over there and check": the second of two coordinated asks (the parser may not
+        # take the first for a verb) asks together with the first, unless that one tells.
+        top = v.head if v.dep_ == "conj" and v.head.i < v.i and not _tells(v.head) else v
+        ask = {t.i for t in top.subtree}
+        for c in top.children:
+            if c.dep_ in _STORY_DEPS and c.i < top.i and _tells(c):
                 ask -= {t.i for t in c.subtree}
         if not ask:
             continue
