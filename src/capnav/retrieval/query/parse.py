@@ -463,8 +463,10 @@ def _request_clause(doc: Doc, mentions: list[tuple[int, int, str]]) -> set[int] 
         if not _asks(v):
             continue
         # "pop over there and check": the second of two coordinated asks (the parser may not
-        # take the first for a verb) asks together with the first, unless that one tells.
-        top = v.head if v.dep_ == "conj" and v.head.i < v.i and not _tells(v.head) else v
+        # take the first for a verb) points back together with the first, unless that one tells
+        # or names an object ("begin at the cooker and work along": the cooker is no goal).
+        top = v.head if v.dep_ == "conj" and v.head.i < v.i and not _tells(v.head) \
+            and not any(t.i == m[0] for t in v.head.subtree for m in mentions) else v
         ask = {t.i for t in top.subtree}
         for c in top.children:
             if c.dep_ in _STORY_DEPS and c.i < top.i and _tells(c):
