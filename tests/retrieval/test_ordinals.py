@@ -133,3 +133,27 @@ def test_the_nth_thing_of_any_kind_from_the_way_in(retriever):
 def test_a_sentence_pointing_back_at_the_goal_is_the_same_goal(text):
     goals = parse_goals(text)
     assert len(goals) == 1 and goals[0].ordinal is not None and goals[0].ordinal > 1
+
+
+# -- a door named by the room the candidates stand in is that room's own door ---------------------
+@pytest.mark.parametrize(("text", "oid"), [
+    ("the second bookshelf from the entrance to the office", 33),
+    ("the third bookshelf from the office door", 32),
+    ("counting from the office door, the second bookshelf", 33),
+])
+def test_a_door_named_by_the_candidates_own_room_is_its_door(retriever: Retriever, text: str, oid: int) -> None:
+    assert _answer(retriever, text) == oid
+
+
+@needs_spacy
+def test_a_door_of_the_room_in_a_parsed_sentence(retriever: Retriever) -> None:
+    assert _answer(retriever, "the second bookshelf in from the doorway of the office") == 33
+
+
+@pytest.mark.parametrize(("text", "oid"), [
+    ("the bookshelf furthest from the corridor door", 32),
+    ("the plant furthest from the kitchen door", 22),
+    ("the bookshelf furthest away from the entrance to the office", 32),
+])
+def test_farthest_from_a_door_reverses_the_order_from_the_way_in(retriever: Retriever, text: str, oid: int) -> None:
+    assert _answer(retriever, text) == oid

@@ -59,3 +59,27 @@ def test_an_ask_that_points_back_at_the_story_keeps_it(retriever: Retriever) -> 
     assert res.found and res.chosen is not None and res.chosen.id == 6, res.reason
     q = parse_instruction("my cat is asleep on the sofa, so take me to the lamp next to it")
     assert q.category == "lamp" and q.relation is not None
+
+
+@needs_spacy
+@pytest.mark.parametrize(("text", "oid"), [
+    # The ask's verb is whatever is said to the robot, not a listed request verb.
+    ("I spilled some tea on the sofa this morning, could you trundle over to the wardrobe please", 6),
+    ("my little nephew hid his toy car behind the sofa, now wander across to the lamp near the bookshelf", 2),
+    # An ask that names no object points back at the story's place, the last one named.
+    ("I was reading on the sofa and I think my glasses fell behind the wardrobe, could you roll over there "
+     "and have a look", 6),
+    ("we were playing cards on the bed and a card slid under the wardrobe, pop over there and see if you can "
+     "spot it", 6),
+    ("the cat was asleep on the sofa earlier but now she is hiding by the bookshelf, can you wander over and "
+     "check on her there", 3),
+])
+def test_any_verb_said_to_the_robot_is_the_ask(retriever: Retriever, text: str, oid: int) -> None:
+    res = retriever.query(text)
+    assert res.found and res.chosen is not None and res.chosen.id == oid, res.reason
+
+
+@needs_spacy
+def test_a_pointer_with_nothing_told_before_it_points_at_nothing() -> None:
+    q = parse_instruction("take me to the lamp and switch it on")
+    assert q.category == "lamp"

@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 from capnav.core.errors import InputError
 from capnav.language.purpose import is_placing
 from capnav.retrieval.constraints.base import RankingConstraint, RankState, ranking
-from capnav.retrieval.query import BETWEEN, END_OF, ROOM_WITH, ParsedQuery, parse_instruction
+from capnav.retrieval.query import ACROSS, BETWEEN, END_OF, ROOM_WITH, ParsedQuery, parse_instruction
 from capnav.retrieval.spatial import end_distance, has_long_axis, segment_distance
 
 BIN_M = 0.25  # distances closer than this are a tie on the relation
@@ -94,6 +94,14 @@ class Relation(RankingConstraint):
             st.values["distance to the line between the landmarks (m)"] = line
             st.group_keys.append(np.round(line / BIN_M))
             st.predicate = f"between the {q.anchor_category} and the {q.anchor2_category}"
+        elif q.relation == ACROSS and q.anchor2_category is not None and len(mid := landmarks(st, True)):
+            # "the armchair across the coffee table from the grey one": the object between lies
+            # on the line from the landmark to the candidate (distance of its centre to it).
+            line = np.array([min((segment_distance(xy[c], xy[i], xy[a_]) for a_ in anchors for c in mid
+                                  if len({int(i), int(a_), int(c)}) == 3), default=np.inf) for i in pool])
+            st.values["distance of the object between to the line (m)"] = line
+            st.group_keys.append(np.round(line / BIN_M))
+            st.predicate = f"across the {q.anchor2_category} from the {q.anchor_category}"
         elif q.relation == END_OF and len(long_ := np.array(
                 [k for k in anchors if has_long_axis(r.objects[k].footprint)], dtype=np.intp)):
             # "the stool at the end of the counter": distance to the nearer end of the

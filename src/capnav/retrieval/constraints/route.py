@@ -64,6 +64,17 @@ def way_in(labels: NDArray[np.int32], to_region: int, from_regions: set[int]
     return door, d / max(float(np.linalg.norm(d)), 1e-9)
 
 
+def neighbours(labels: NDArray[np.int32], region: int) -> set[int]:
+    """The regions that touch ``region`` (its doors lead to them)."""
+    inside = labels == region
+    out: set[int] = set()
+    for dr, dc in ((1, 0), (-1, 0), (0, 1), (0, -1)):
+        a = inside[max(dr, 0):inside.shape[0] + min(dr, 0), max(dc, 0):inside.shape[1] + min(dc, 0)]
+        b = labels[max(-dr, 0):labels.shape[0] + min(-dr, 0), max(-dc, 0):labels.shape[1] + min(-dc, 0)]
+        out |= {int(x) for x in np.unique(b[a])}
+    return out - {region, -1}
+
+
 @ranking
 class Route(RankingConstraint):
     kind = "route"
@@ -91,26 +102,30 @@ class Route(RankingConstraint):
             return
         spec = scene.occupancy.spec if scene.occupancy is not None else None
         assert spec is not None
+        # "the second bookshelf from the office door" when the bookshelves stand in the office:
+        # the door named by the candidates' own room is that room's door, the way in from the
+        # regions next to it (the nearest of them when it has several).
+        own = all(int(scene.region[i]) in origin for i in pool if int(scene.region[i]) >= 0)
         dist = np.full(len(pool), np.inf)
         side = np.zeros(len(pool))  # +1 left, -1 right, 0 unknown
-        doors: dict[int, tuple[NDArray[np.float64], NDArray[np.float64]] | None] = {}
+        doors: dict[int, list[tuple[NDArray[np.float64], NDArray[np.float64]]]] = {}
         for k, i in enumerate(pool):
             reg = int(scene.region[i])
-            if reg < 0 or reg in origin:
+            if reg < 0 or (reg in origin and not own):
                 continue
             if reg not in doors:
-                doors[reg] = way_in(labels, reg, origin)
-            w = doors[reg]
-            if w is None:
-                continue
-            door_rc, d_rc = w
-            door = spec.to_world(np.round(door_rc).astype(np.int64)[None])[0]
-            tip = spec.to_world(np.round(door_rc + 10 * d_rc).astype(np.int64)[None])[0]
-            heading = (tip - door) / max(float(np.linalg.norm(tip - door)), 1e-9)
-            v = np.asarray(r.objects[i].position[:2], dtype=np.float64) - door
-            dist[k] = float(np.linalg.norm(v))
-            cross = heading[0] * v[1] - heading[1] * v[0]
-            side[k] = 1.0 if cross > 0 else -1.0
+                ways = [way_in(labels, reg, {n}) for n in sorted(neighbours(labels, reg))] if own \
+                    else [way_in(labels, reg, origin)]
+                doors[reg] = [w for w in ways if w is not None]
+            for door_rc, d_rc in doors[reg]:
+                door = spec.to_world(np.round(door_rc).astype(np.int64)[None])[0]
+                tip = spec.to_world(np.round(door_rc + 10 * d_rc).astype(np.int64)[None])[0]
+                heading = (tip - door) / max(float(np.linalg.norm(tip - door)), 1e-9)
+                v = np.asarray(r.objects[i].position[:2], dtype=np.float64) - door
+                if float(np.linalg.norm(v)) < dist[k]:
+                    dist[k] = float(np.linalg.norm(v))
+                    cross = heading[0] * v[1] - heading[1] * v[0]
+                    side[k] = 1.0 if cross > 0 else -1.0
         known = np.isfinite(dist)
         if not known.any():
             st.notes.append(f"no candidate stands in a region that opens onto the {q.origin_room}; "
@@ -122,16 +137,19 @@ class Route(RankingConstraint):
                 st.report(self.kind, int(i), Evidence(self.kind, UNOBSERVED, 0.0,
                                                       f"its room does not open onto the {q.origin_room}"))
                 continue
-            where = f"{dist[k]:.1f} m from the way in from the {q.origin_room}"
+            where = f"{dist[k]:.1f} m from the {q.origin_room}'s door" if own else \
+                f"{dist[k]:.1f} m from the way in from the {q.origin_room}"
             if want:
                 where += f", on the {'left' if side[k] > 0 else 'right'}"
             st.report(self.kind, int(i), Evidence(self.kind, SUPPORTED, 1.0, where))
-        rank_key = np.where(known, dist, 1e9)
+        # "the bookshelf furthest from the office door": the order from the way in, reversed.
+        rank_key = np.where(known, -dist if q.proximity == "farthest" else dist, 1e9)
         if want:
             # The side first, then the order met from the way in.
             st.group_keys.append(-(side == want).astype(np.float64))
         st.group_keys.append(rank_key)
         st.values["from the way in (m)"] = np.where(known, dist, -1.0)
         st.predicate, st.mode = "route", "predicate"
-        st.notes.append(f"ordered from the way in from the {q.origin_room}"
+        st.notes.append((f"ordered from the door of the {q.origin_room} they stand in" if own
+                         else f"ordered from the way in from the {q.origin_room}")
                         + (f", {q.side} side first" if want else ""))

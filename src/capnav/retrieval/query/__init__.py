@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 from capnav.core.errors import InputError
 from capnav.retrieval.query.mapping import goal_query
-from capnav.retrieval.query.model import BETWEEN, END_OF, ROOM_WITH, ParsedQuery
+from capnav.retrieval.query.model import ACROSS, BETWEEN, END_OF, ROOM_WITH, ParsedQuery
 from capnav.retrieval.query.parse import analyse, load_parser, needs_parse, prefetch_parser, split_goals
 from capnav.retrieval.query.tokens import MAX_CHARS, MAX_WORDS, validate_instruction
 
@@ -48,6 +48,7 @@ def parse_instruction(text: str, embedder: TextEmbedder | None = None, use_parse
 
 
 __all__ = [
+    "ACROSS",
     "BETWEEN",
     "END_OF",
     "MAX_CHARS",

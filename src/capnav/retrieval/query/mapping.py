@@ -16,7 +16,7 @@ from capnav.language.colors import ALIASES, LEXICON
 from capnav.language.context import ROOM_SYNONYMS
 from capnav.language.purpose import find_activity, match_purpose, purpose_categories
 from capnav.retrieval.query.count import read_count, without
-from capnav.retrieval.query.model import BETWEEN, ROOM_WITH, ParsedQuery
+from capnav.retrieval.query.model import ACROSS, BETWEEN, ROOM_WITH, ParsedQuery
 from capnav.retrieval.query.parse import _GENERIC, GoalParse, describe
 from capnav.retrieval.query.tokens import (
     _COMMON_ADJECTIVES,
@@ -200,6 +200,51 @@ def _between(q: ParsedQuery, head: str) -> str:
     q.anchor_category, q.anchor_phrase = first[0], first[1]
     q.anchor2_category, q.anchor2_phrase = second[0], second[1]
     return " ".join([head[: m.start()], *second[2]]).strip()
+
+
+def _stand_in_landmark(words: list[str], before: str) -> tuple[str, str, list[str]] | None:
+    """A landmark said by a word standing in for the target's own category ("the sink opposite
+    the black one", "the lamp beside the other one"): (the category named before it, the
+    landmark's words, the words after it). The landmark is then another instance of the target's
+    category, picked by its own words. None when ``words`` name a category or no stand-in."""
+    if _landmark(words) is not None:
+        return None
+    k = next((i for i, w in enumerate(words) if w in ("one", "ones")), None)
+    target = _landmark(before.split())
+    if k is None or target is None:
+        return None
+    return target[0], " ".join(words[: k + 1]), words[k + 1:]
+
+
+#: "across the coffee table from the grey one", "facing the red one across the coffee table":
+#: the target and a landmark on either side of a second landmark.
+_ACROSS = [
+    re.compile(rf"\b(?:directly\s+|right\s+|straight\s+)?(?:across|over|on\s+the\s+(?:other|far|opposite)\s+side"
+               rf"\s+of)\s+{_ARTICLE}(?P<mid>.+?)\s+from\s+{_ARTICLE}"
+               rf"(?P<lm>.+)$"),
+    re.compile(rf"\b(?:directly\s+|right\s+|straight\s+)?(?:facing|opposite|across\s+from|looking\s+at)\s+"
+               rf"{_ARTICLE}(?P<lm>.+?)\s+(?:across|over|on\s+the\s+other\s+side\s+of)\s+{_ARTICLE}(?P<mid>.+)$"),
+]
+
+
+def _across(q: ParsedQuery, head: str) -> str:
+    """"the armchair across the coffee table from the light grey one": the landmark (``anchor``)
+    and the object between it and the target (``anchor2``); either may be a stand-in for the
+    target's category. Returns ``head`` without the phrase."""
+    for pat in _ACROSS:
+        m = pat.search(head)
+        if not m or m.start() == 0:
+            continue
+        before = head[: m.start()]
+        mid = _landmark(m.group("mid").split())
+        lm = _landmark(m.group("lm").split()) or _stand_in_landmark(m.group("lm").split(), before)
+        if mid is None or lm is None or mid[2] or lm[2]:
+            continue
+        q.relation = ACROSS
+        q.anchor_category, q.anchor_phrase = lm[0], lm[1]
+        q.anchor2_category, q.anchor2_phrase = mid[0], mid[1]
+        return before.strip()
+    return head
 
 
 def _clause_landmark(q: ParsedQuery, head: str) -> str:
@@ -407,6 +452,9 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     # "the lamp between the bed and the wardrobe": two landmarks.
     if q.anchor_category is None:
         head = _between(q, head)
+    # "the armchair across the coffee table from the grey one": a landmark and what is between.
+    if q.anchor_category is None:
+        head = _across(q, head)
     # Relation: "<target> next to the <anchor>".
     if q.anchor_category is None:
         for rel in _RELATIONS:
@@ -414,6 +462,13 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
             if m and m.start() > 0:
                 anchor_words = m.group(1).split()
                 cat, _, _ = _find_category(anchor_words)
+                stand_in = _stand_in_landmark(anchor_words, head[: m.start()]) if cat is None else None
+                if stand_in is not None and not stand_in[2]:
+                    # "the sink opposite the black one": another of the target's category.
+                    q.relation = "next to" if rel in ("besides", "beside", "by", "close to", "alongside") else rel
+                    q.anchor_category, q.anchor_phrase = stand_in[0], stand_in[1]
+                    head = head[: m.start()]
+                    break
                 if cat is not None and _verb_only(head[:m.start()]):
                     # "swing by the fridge", "pop by the stove": a verb of going with its
                     # preposition, no object before it: the landmark is the goal.

@@ -7,8 +7,10 @@ from dataclasses import dataclass, field
 
 #: Relations whose geometry the retriever measures beyond the gap: "between" two landmarks
 #: (``anchor2_category``), "at the end of" a long object (the ends of its long axis), and
-#: "in the room with" a landmark (its room region).
+#: "in the room with" a landmark (its room region), and "across" a second landmark from the first
+#: ("the armchair across the coffee table from the grey one": the coffee table between them).
 BETWEEN = "between"
+ACROSS = "across"
 END_OF = "at the end of"
 ROOM_WITH = "in the room with"
 

@@ -394,21 +394,90 @@ def _back_references(doc: Doc, ask: set[int], mentions: list[tuple[int, int, str
             if doc[i].lower_ in _BACK_REFERENCES and doc[i].pos_ == "PRON" and doc[i].dep_ == "pobj"}
 
 
+#: Modal verbs of a polite request put as a question ("could you roll over", "would you pop by").
+_ASK_MODALS = {"could", "can", "would", "will"}
+#: Dependencies of a verb that is no clause of its own (an infinitive, a participle as a modifier).
+_NOT_CLAUSE = {"xcomp", "aux", "auxpass", "amod", "acl", "relcl", "pcomp", "csubj", "advcl", "mark"}
+
+
+def _asks(v: Token) -> bool:
+    """Whether verb ``v`` asks the robot to do something: a request verb, or any verb said to the
+    robot (an imperative with no subject of its own, "zip over there", "pop by"; or a question to
+    "you" with a modal, "could you roll over ..."): the structure, not a list, says it is the ask."""
+    if v.pos_ != "VERB":
+        return False
+    if (v.lemma_ or v.lower_).lower() in _REQUEST_VERBS:
+        return True
+    subj = [c for c in v.children if c.dep_ in ("nsubj", "nsubjpass", "expl")]
+    if subj:
+        return any(c.lower_ == "you" for c in subj) and v.tag_ == "VB" \
+            and any(c.dep_ == "aux" and c.lower_ in _ASK_MODALS for c in v.children)
+    if v.tag_ not in ("VB", "VBP") or v.dep_ in _NOT_CLAUSE:
+        return False
+    return not any(c.dep_ == "aux" for c in v.children)  # "to roll", "do roll": no imperative
+
+
+def _pointer_referent(doc: Doc, ask: set[int], mentions: list[tuple[int, int, str]]) -> set[int] | None:
+    """An ask that names no object but points back ("could you roll over there", "pop over and
+    have a look at it"): the phrase of the story's last object named before it (a correction,
+    "maybe on the sofa, no, on the nightstand", names its place last). None when it points at
+    nothing."""
+    if not any(doc[i].lower_ in _POINTERS and doc[i].pos_ in ("ADV", "PRON")
+               and doc[i].dep_ not in ("nsubj", "nsubjpass", "expl") for i in ask):
+        return None
+    heads = [_span_head(doc, m[0], m[1]) for m in mentions if m[0] not in ask and m[0] < min(ask)]
+    if not heads:
+        return None
+    # The place the last telling clause names first ("it was on the counter with the sink": the
+    # counter; the sink, however the parser hangs it, is its landmark).
+    # The rest of that clause from there on says which one ("on the desk in there, not the one in
+    # the office"): the clauses hung on its verb that are not about the place are left out.
+    verb = _clause_verb(heads[-1])
+    h = next(x for x in heads if _clause_verb(x) == verb)
+    v = doc[verb]
+    out = {t.i for t in v.subtree if h.left_edge.i <= t.i < min(ask)}
+    for c in v.children:
+        if c.pos_ in ("VERB", "AUX") and c.dep_ in _STORY_DEPS and h.i not in {t.i for t in c.subtree}:
+            out -= {t.i for t in c.subtree}
+    return out or {t.i for t in h.subtree}
+
+
+def _clause_verb(t: Token) -> int:
+    """The index of the verb whose clause ``t`` stands in (the root when there is none)."""
+    node = t
+    for _ in range(64):
+        if node.head.i == node.i or node.head.pos_ in ("VERB", "AUX"):
+            return node.head.i
+        node = node.head
+    return node.i
+
+
 def _request_clause(doc: Doc, mentions: list[tuple[int, int, str]]) -> set[int] | None:
-    """The tokens of the clause that asks: the subtree of the last request verb that names an
-    object, without the telling clauses hung on it before it ("my jumper is on the bed, so bring
-    me to the wardrobe": the parser makes the story a complement of "bring"). Only when what lies
-    outside it tells a story that names an object or an attribute. None when the whole text is
-    the ask."""
+    """The tokens of the clause that asks: the subtree of the last verb said to the robot
+    (``_asks``) that names an object, without the telling clauses hung on it before it ("my
+    jumper is on the bed, so bring me to the wardrobe": the parser makes the story a complement
+    of "bring"); an ask that names none but points back at the story ("... it was on the
+    nightstand, zip over there") is the object it points at. Only when what lies outside it
+    tells a story that names an object or an attribute. None when the whole text is the ask."""
     for v in reversed(doc):
-        if v.pos_ != "VERB" or (v.lemma_ or v.lower_).lower() not in _REQUEST_VERBS:  # an ask is in the base form
+        if not _asks(v):
             continue
-        ask = {t.i for t in v.subtree}
-        for c in v.children:
-            if c.dep_ in _STORY_DEPS and c.i < v.i and _tells(c):
+        # "pop over there and check": the second of two coordinated asks (the parser may not
+        # take the first for a verb) points back together with the first, unless that one tells
+        # or names an object ("begin at the cooker and work along": the cooker is no goal).
+        top = v.head if v.dep_ == "conj" and v.head.i < v.i and not _tells(v.head) \
+            and not any(t.i == m[0] for t in v.head.subtree for m in mentions) else v
+        ask = {t.i for t in top.subtree}
+        for c in top.children:
+            if c.dep_ in _STORY_DEPS and c.i < top.i and _tells(c):
                 ask -= {t.i for t in c.subtree}
-        if not any(m[0] in ask for m in mentions):
+        if not ask:
             continue
+        if not any(m[0] in ask for m in mentions):
+            referent = _pointer_referent(doc, ask, mentions)
+            if referent is None:
+                continue
+            ask = ask | referent
         outside = [t for t in doc if t.i not in ask]
         tells = any(_tells(t) for t in outside if t.pos_ in ("VERB", "AUX"))
         named = any(m[0] not in ask for m in mentions) or any(attribute_word(t.lower_) for t in outside)
@@ -493,6 +562,9 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
             sub = {t.i for t in c.subtree}
             if sub & named or any(doc[k].dep_ == "neg" or doc[k].lower_ in _NEGATIVE for k in sub):
                 continue
+            if any(doc[k].lower_ in ("one", "ones") and doc[k].dep_ == "pobj" for k in sub):
+                continue  # "from the green one": a stand-in for another of the target's kind, an object
+
             if any(attribute_word(doc[k].lower_) for k in sub):
                 keep -= sub
     # Rooms one comes from or passes through are not where the target stands.
