@@ -1,6 +1,11 @@
 """Persistent object memory: what survives the tracker (the paper's tracks die; a map must not).
 
 A track feeds nothing until it is confirmed (``h_min`` hits); its first detections are buffered.
+A track that dies unconfirmed leaves its buffer behind (``pool_unconfirmed``): a later track whose
+detection overlaps it in 3D with a compatible label takes it over, and its hits count towards that
+track's ``h_min``. Confirmation counts the detections of one 3D thing, not of one track: a small
+object seen in a few frames scattered more than ``m_max`` apart (a plant glimpsed on passing)
+would otherwise be split over short tracks that each die below ``h_min``.
 On confirmation it is linked either to an existing object (a revisit: the buffered points overlap
 the object's points in 3D and the labels agree) or to a new object. Linked tracks add every later
 detection to their object. When the track dies the object stays. ``finish`` merges duplicates
@@ -45,7 +50,12 @@ class MemoryConfig:
     object is missed in that frame (0.8 m apart costs 0.68 < tau). A detection of a linked track
     whose points lie outside the object's box grown by ``recheck_margin`` (fraction inside below
     ``recheck_inside``) and almost nowhere near its points is re-linked by overlap, as on
-    confirmation, instead of corrupting the object."""
+    confirmation, instead of corrupting the object.
+
+    ``pool_unconfirmed``: the buffered detections of a track that died before ``h_min`` hits are
+    kept and count for a later track of the same thing (3D overlap as above, compatible label or
+    descriptor), so ``h_min`` detections of one place make an object however far apart in time;
+    random false positives (random place and label) still never add up."""
 
     point_voxel: float = 0.03
     max_points: int = 3000
@@ -62,11 +72,22 @@ class MemoryConfig:
     recheck_inside: float = 0.2
     recheck_min_points: int = 50
     same_overlap: float = 0.95
+    pool_unconfirmed: bool = True
     seed: int = 0
 
     def __post_init__(self) -> None:
         if self.point_voxel <= 0 or self.max_points < 10 or self.max_observations < 1:
             raise InputError("point_voxel > 0, max_points >= 10 and max_observations >= 1 are required")
+
+
+@dataclass
+class _Dormant:
+    """The buffered detections of a track that died unconfirmed."""
+
+    label: str
+    feature: NDArray[np.float32]
+    buf: list[tuple[LiftedDetection, Observation, int]]
+    points: NDArray[np.float32]
 
 
 @dataclass
@@ -106,6 +127,8 @@ class ObjectMemory:
         self.objects: dict[int, _ObjectState] = {}
         self._pending: dict[int, list[tuple[LiftedDetection, Observation, int]]] = {}
         self._restarted: dict[int, int] = {}  # track id -> its hits before a recheck restarted it
+        self._dormant: list[_Dormant] = []  # buffers of tracks that died unconfirmed (pool_unconfirmed)
+        self._inherited: dict[int, int] = {}  # track id -> detections it took over from dormant buffers
         self._next_id = 1
         self.relinks = 0  # detections moved to another object by the recheck
         self._rng = np.random.default_rng(self.config.seed)
@@ -120,11 +143,14 @@ class ObjectMemory:
         if track.object_id is None:
             buf = self._pending.setdefault(track.id, [])
             buf.append((det, obs, frame))
-            if track.hits - self._restarted.get(track.id, 0) < h_min:
+            if self.config.pool_unconfirmed and self._dormant:
+                self._adopt(track, det, buf)
+            if track.hits - self._restarted.get(track.id, 0) + self._inherited.get(track.id, 0) < h_min:
                 return None
             oid = self._link(track, buf, busy)
             track.object_id = oid
             self._restarted.pop(track.id, None)
+            self._inherited.pop(track.id, None)
             for d, o, f in self._pending.pop(track.id):
                 self._add(self.objects[oid], d, o, f)
             return oid
@@ -157,9 +183,45 @@ class ObjectMemory:
         return float(np.isfinite(d).mean()) < 0.05
 
     def drop(self, track: Track) -> None:
-        """A track died: unconfirmed detections are forgotten (false positives), objects stay."""
-        self._pending.pop(track.id, None)
+        """A track died: objects stay; its unconfirmed detections wait for a later track of the same
+        thing (``pool_unconfirmed``; else they are forgotten)."""
+        buf = self._pending.pop(track.id, None)
         self._restarted.pop(track.id, None)
+        self._inherited.pop(track.id, None)
+        if buf and self.config.pool_unconfirmed and track.object_id is None:
+            pts = np.concatenate([d.points for d, _, _ in buf])
+            if len(pts):
+                feat = np.mean([d.descriptor for d, _, _ in buf], axis=0).astype(np.float32)
+                self._dormant.append(_Dormant(track.label, feat, buf, pts))
+
+    def _adopt(self, track: Track, det: LiftedDetection, buf: list[tuple[LiftedDetection, Observation, int]]
+               ) -> None:
+        """Move into ``buf`` (before its detections) the dormant buffers ``det`` overlaps in 3D with a
+        compatible label or descriptor; their detections count as the track's hits."""
+        pts = det.points
+        if len(pts) == 0:
+            return
+        r = self.config.overlap_radius
+        lo, hi = pts.min(axis=0) - r, pts.max(axis=0) + r
+        keep: list[_Dormant] = []
+        taken: list[tuple[LiftedDetection, Observation, int]] = []
+        for dm in self._dormant:
+            if (np.any(dm.points.min(axis=0) > hi) or np.any(dm.points.max(axis=0) < lo)
+                    or not self._same_kind(track.label, det.descriptor, dm)
+                    or max(self._overlap(pts, dm.points), self._overlap(dm.points, pts)) == 0.0):
+                keep.append(dm)
+                continue
+            taken += dm.buf
+        if taken:
+            self._dormant = keep
+            buf[:0] = taken
+            self._inherited[track.id] = self._inherited.get(track.id, 0) + len(taken)
+
+    def _same_kind(self, label: str, feat: NDArray[np.floating], dm: _Dormant) -> bool:
+        if labels_compatible(label, dm.label):
+            return True
+        na, nb = float(np.linalg.norm(feat)), float(np.linalg.norm(dm.feature))
+        return na > 0 and nb > 0 and float(np.dot(feat, dm.feature)) / (na * nb) >= self.config.min_cos
 
     def _link(self, track: Track, buf: list[tuple[LiftedDetection, Observation, int]], busy: set[int]) -> int:
         """The object ``buf``'s detections belong to: the best overlapping compatible one, else a new one."""
@@ -247,6 +309,7 @@ class ObjectMemory:
         """The frames the kept and the buffered observations refer to."""
         out = {o.frame_index for obj in self.objects.values() for o in obj.observations}
         out |= {f for buf in self._pending.values() for _, _, f in buf}
+        out |= {f for dm in self._dormant for _, _, f in dm.buf}
         return out
 
     def carve(self, views: DepthViews) -> int:

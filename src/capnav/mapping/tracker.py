@@ -15,7 +15,9 @@ parameters; ours, for indoor mapping at 0.1-0.3 m between frames:
   should be smooth, boxes follow the moving camera faster;
 * ``m_max = 10`` frames: a few seconds out of view; persistence (``ObjectMemory``) keeps the
   object after the track dies, so a short ``m_max`` costs nothing;
-* ``h_min = 3`` hits: one or two false positives never become objects;
+* ``h_min = 3`` hits: one or two false positives never become objects. ``ObjectMemory`` counts
+  them per 3D place, not per track: a track that dies unconfirmed leaves its detections to a later
+  track of the same place (a small object seen in frames scattered more than ``m_max`` apart);
 * ``max_speed = 0.05`` m/frame clips the velocity of eq. 11 (not in the paper): objects are
   static, and the centroid jitter of a moving camera would otherwise be extrapolated during a miss.
 
