@@ -10,6 +10,7 @@ from _synth_scene import Box, render
 
 from capnav.core.geometry import Intrinsics, look_at_pose
 from capnav.mapping import Mapper, MapperConfig
+from capnav.mapping.memory import MemoryConfig
 from capnav.perception import create_detector, create_encoder
 
 # A 0.25 m plant-sized box (category 16 plant) 1.6 m in front of the camera at +x.
@@ -27,8 +28,8 @@ def _frames(seen: list[int], n: int) -> list:
     return out
 
 
-def _map(embedder, seen: list[int], n: int):  # type: ignore[no-untyped-def]
-    m = Mapper(MapperConfig(), create_detector("sim", noise="oracle", seed=0),
+def _map(embedder, seen: list[int], n: int, memory: MemoryConfig | None = None):  # type: ignore[no-untyped-def]
+    m = Mapper(MapperConfig(memory=memory or MemoryConfig()), create_detector("sim", noise="oracle", seed=0),
                create_encoder("label-embedding", embedder=embedder))
     for f in _frames(seen, n):
         m.integrate(f)
@@ -48,4 +49,11 @@ def test_small_object_seen_in_scattered_frames_becomes_an_object(embedder) -> No
 
 def test_two_scattered_sightings_stay_below_h_min(embedder) -> None:  # type: ignore[no-untyped-def]
     _, cmap = _map(embedder, [3, 25], 40)  # one or two detections of a thing never make an object
+    assert cmap.objects == []
+
+
+def test_the_dormant_buffers_are_bounded(embedder) -> None:  # type: ignore[no-untyped-def]
+    """Long recordings keep at most ``max_dormant`` dead tracks' buffers: with none kept, the
+    scattered sightings are forgotten as before the pool."""
+    _, cmap = _map(embedder, [3, 5, 20, 36, 38], 50, MemoryConfig(max_dormant=0))
     assert cmap.objects == []

@@ -73,11 +73,13 @@ class MemoryConfig:
     recheck_min_points: int = 50
     same_overlap: float = 0.95
     pool_unconfirmed: bool = True
+    max_dormant: int = 512  # buffers of dead unconfirmed tracks kept (the oldest go first): bounded on long recordings
     seed: int = 0
 
     def __post_init__(self) -> None:
-        if self.point_voxel <= 0 or self.max_points < 10 or self.max_observations < 1:
-            raise InputError("point_voxel > 0, max_points >= 10 and max_observations >= 1 are required")
+        if self.point_voxel <= 0 or self.max_points < 10 or self.max_observations < 1 or self.max_dormant < 0:
+            raise InputError("point_voxel > 0, max_points >= 10, max_observations >= 1 and max_dormant >= 0 "
+                             "are required")
 
 
 @dataclass
@@ -193,6 +195,7 @@ class ObjectMemory:
             if len(pts):
                 feat = np.mean([d.descriptor for d, _, _ in buf], axis=0).astype(np.float32)
                 self._dormant.append(_Dormant(track.label, feat, buf, pts))
+                del self._dormant[: max(0, len(self._dormant) - self.config.max_dormant)]
 
     def _adopt(self, track: Track, det: LiftedDetection, buf: list[tuple[LiftedDetection, Observation, int]]
                ) -> None:
