@@ -274,24 +274,33 @@ def _labels(wn: Any, forms: dict[str, str]) -> dict[str, str]:
 SIZE_HEADS = {"large": "large.a.01", "small": "small.a.01"}
 
 
-def _sizes(wn: Any, exceptions: list[str]) -> dict[str, str]:
-    """Size adjectives -> "large" / "small" (see the module docstring)."""
+def _cluster_adjectives(wn: Any, head: Any) -> list[str]:
+    """The lemmas of the adjective cluster around the synset ``head`` (it and its similar-tos)
+    whose most frequent adjective sense lies in the cluster and which WordNet's sense-tagged corpus
+    does not use more often as a noun or verb; lower-case single words (hyphens allowed)."""
 
     def count(lemma: str, pos: str) -> int:
         return sum(lem.count() for s in wn.synsets(lemma, pos) for lem in s.lemmas() if lem.name() == lemma)
 
+    cluster = {head, *head.similar_tos()}
+    out = []
+    for lemma in sorted({lem.name() for s in cluster for lem in s.lemmas()}):
+        if lemma != lemma.lower() or "_" in lemma:
+            continue
+        senses = [s for s in wn.synsets(lemma) if s.pos() in "as" and any(lem.name() == lemma for lem in s.lemmas())]
+        if not senses or senses[0] not in cluster:
+            continue
+        if max(count(lemma, "n"), count(lemma, "v")) > count(lemma, "a"):
+            continue
+        out.append(lemma)
+    return out
+
+
+def _sizes(wn: Any, exceptions: list[str]) -> dict[str, str]:
+    """Size adjectives -> "large" / "small" (see the module docstring)."""
     out: dict[str, str] = {}
     for size, head in SIZE_HEADS.items():
-        cluster = {wn.synset(head), *wn.synset(head).similar_tos()}
-        for lemma in sorted({lem.name() for s in cluster for lem in s.lemmas()}):
-            if lemma != lemma.lower() or "_" in lemma:
-                continue
-            senses = [s for s in wn.synsets(lemma) if s.pos() in "as"
-                      and any(lem.name() == lemma for lem in s.lemmas())]
-            if not senses or senses[0] not in cluster:
-                continue
-            if max(count(lemma, "n"), count(lemma, "v")) > count(lemma, "a"):
-                continue
+        for lemma in _cluster_adjectives(wn, wn.synset(head)):
             out[lemma] = size
             if "-" in lemma:
                 out[lemma.replace("-", " ")] = size
@@ -313,10 +322,6 @@ def _heights(wn: Any, sizes: dict[str, str]) -> tuple[dict[str, str], dict[str, 
     high, low) with their regular comparatives and superlatives ("taller", "lowest"), and the
     lemmas of the stature clusters whose most frequent adjective sense lies in them ("lanky",
     "stumpy"), as the size words are chosen; a word of the size table ("little") stays a size."""
-
-    def count(lemma: str, pos: str) -> int:
-        return sum(lem.count() for s in wn.synsets(lemma, pos) for lem in s.lemmas() if lem.name() == lemma)
-
     words: dict[str, str] = {}
     superlative: dict[str, str] = {}
     for dim, head in HEIGHT_HEADS.items():
@@ -326,19 +331,10 @@ def _heights(wn: Any, sizes: dict[str, str]) -> tuple[dict[str, str], dict[str, 
             word = syn.lemmas()[0].name()  # the head word: regular -er / -est
             words[word] = words[word + "er"] = size
             superlative[word + "est"] = {"large": "largest", "small": "smallest"}[size]
-            if dim != "stature":
-                continue
-            cluster = {syn, *syn.similar_tos()}
-            for lemma in sorted({lem.name() for c in cluster for lem in c.lemmas()}):
-                if lemma != lemma.lower() or "_" in lemma or lemma in words or lemma in sizes:
-                    continue
-                senses = [s for s in wn.synsets(lemma) if s.pos() in "as"
-                          and any(lem.name() == lemma for lem in s.lemmas())]
-                if not senses or senses[0] not in cluster:
-                    continue
-                if max(count(lemma, "n"), count(lemma, "v")) > count(lemma, "a"):
-                    continue
-                words[lemma] = size
+            if dim == "stature":
+                for lemma in _cluster_adjectives(wn, syn):
+                    if lemma not in words and lemma not in sizes:
+                        words[lemma] = size
     return dict(sorted(words.items())), dict(sorted(superlative.items()))
 
 
