@@ -59,8 +59,10 @@ class MemoryConfig:
     it finds the small and glimpsed things (seed 100's cactus, the demo apartment's fifth
     armchair, Yolo-Fastest recall 33 -> 40% on Sweet Home 3D seed 0 at 100% precision), but on the
     demo apartment the map it makes puts a plant's room region in the office instead of the
-    living room ("the potted plant in the lounge" then fails), and why an added object moves a
-    room's region is not traced yet."""
+    living room ("the potted plant in the lounge" then fails): the plant stands in a pocket of
+    free space between a wall, a bookshelf and a sofa that one row of cells joins to its room
+    (``language.rooms.walkable_domain``), and with the other map's boxes that row is not in the
+    domain, so only the office's cells across the wall vote in ``object_region``."""
 
     point_voxel: float = 0.03
     max_points: int = 3000
