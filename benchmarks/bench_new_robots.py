@@ -41,6 +41,8 @@ def main() -> None:
     ap.add_argument("--fields", type=int, default=1, help="1: per-object fields (default), 0: without")
     ap.add_argument("--check", action="store_true", help="compare every timed answer with one asked without fields")
     args = ap.parse_args()
+    if args.asks < 1 or args.instructions < 1 or args.objects < 1:
+        ap.error("--asks, --instructions and --objects must be at least 1")
 
     cmap = synthetic_map(args.objects, args.seed)
     describe_map(cmap, None, create_captioner("offline"), create_embedder("minilm"), progress=False)
