@@ -167,6 +167,19 @@ def test_floor_distances_give_the_floats_of_the_heap_dijkstra_and_the_per_box_lo
     assert 0 < finite < 6 * len(los) and ring > 0  # unreached boxes, and one measured at its ring
 
 
+def _closed_room_scene(rng: np.random.Generator, n: int
+                       ) -> tuple[GridSpec, OccupancyGrid, np.ndarray, np.ndarray]:
+    """Rooms with doors on a 3 x 4.5 m grid of 10 cm cells, one room walled shut, and ``n`` random
+    object boxes (lows, highs), some poking off the grid."""
+    spec = GridSpec(0.0, 0.0, 0.1, 30, 45)
+    dom = rooms_with_doors(rng, 30, 45)
+    dom[18:27, 30:39] = False
+    dom[19:26, 31:38] = True
+    occ = OccupancyGrid(spec, np.where(dom, FREE, OCCUPIED).astype(np.uint8))
+    los = rng.uniform([-0.4, -0.4], [4.4, 2.9], (n, 2))
+    return spec, occ, los, los + rng.uniform(0.05, 0.6, (n, 2))
+
+
 @pytest.mark.parametrize("seed", [0, 1, 2, 3])
 def test_a_walk_stopped_once_some_objects_are_measured_gives_their_floats(seed: int) -> None:
     # "The closest chair" measures the chairs only: the walk stops once each holds an expanded
@@ -174,13 +187,7 @@ def test_a_walk_stopped_once_some_objects_are_measured_gives_their_floats(seed: 
     # reached (in the closed room, or off the grid): then the walk ran on and every object has its
     # value. A later ask from the same cell fills in what the first left out.
     rng = np.random.default_rng(30 + seed)
-    spec = GridSpec(0.0, 0.0, 0.1, 30, 45)
-    dom = rooms_with_doors(rng, 30, 45)
-    dom[18:27, 30:39] = False
-    dom[19:26, 31:38] = True
-    occ = OccupancyGrid(spec, np.where(dom, FREE, OCCUPIED).astype(np.uint8))
-    los = rng.uniform([-0.4, -0.4], [4.4, 2.9], (40, 2))
-    his = los + rng.uniform(0.05, 0.6, (40, 2))
+    spec, occ, los, his = _closed_room_scene(rng, 40)
     los[-2:] = [spec.to_world(np.array([22, 35])), [-3.0, -3.0]]  # in the closed room; off the grid
     his[-2:] = [spec.to_world(np.array([24, 36])), [-2.0, -2.0]]
     whole = FloorDistances(occ, los, his, cache_size=0)
@@ -217,13 +224,7 @@ def test_an_objects_walk_field_gives_the_floats_of_the_walk_from_the_robot(seed:
     from capnav.core.geodesic import NO_WALK, walk_field, walk_value
 
     rng = np.random.default_rng(50 + seed)
-    spec = GridSpec(0.0, 0.0, 0.1, 30, 45)
-    dom = rooms_with_doors(rng, 30, 45)
-    dom[18:27, 30:39] = False
-    dom[19:26, 31:38] = True
-    occ = OccupancyGrid(spec, np.where(dom, FREE, OCCUPIED).astype(np.uint8))
-    los = rng.uniform([-0.4, -0.4], [4.4, 2.9], (30, 2))
-    his = los + rng.uniform(0.05, 0.6, (30, 2))
+    spec, occ, los, his = _closed_room_scene(rng, 30)
     los[-1], his[-1] = spec.to_world(np.array([22, 35])), spec.to_world(np.array([24, 36]))  # in the closed room
     plain = FloorDistances(occ, los, his, cache_size=0, field_bytes=0)
     full = FloorDistances(occ, los, his, cache_size=0)
