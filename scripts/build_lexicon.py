@@ -206,6 +206,7 @@ def build(wordnet: Path) -> dict[str, Any]:
         out["placing"] = _placing(wn)
         out["body"] = _body(wn, (wordnet / "noun.exc").read_text().splitlines())
         out["materials"] = _materials(wn, out["forms"], out["labels"])
+        out["rooms"] = _rooms(wn, out["forms"], (wordnet / "noun.exc").read_text().splitlines())
         out["forms"] = dict(sorted(out["forms"].items()))
         return out
 
@@ -527,6 +528,66 @@ def _materials(wn: Any, forms: dict[str, str], labels: dict[str, str]) -> dict[s
         if m is not None:
             out[w] = m
     return out
+
+
+#: CapNav's room types (``capnav.language.context``) and the WordNet synsets each one is; a name
+#: ending in "!" is taken without its hyponyms (the hyponyms of ``office.n.01`` are places of
+#: business: box offices, newsrooms). The washroom and the powder room are under
+#: ``toilet.n.01``, a room WordNet defines by its fixture: its own lemmas are the toilet's forms
+#: (``_rooms_of_fixtures``), its other hyponyms name the bathroom.
+ROOM_ROOTS: dict[str, list[str]] = {
+    "kitchen": ["kitchen.n.01"], "bedroom": ["bedroom.n.01"],
+    "bathroom": ["bathroom.n.01", "toilet.n.01"], "living room": ["living_room.n.01"],
+    "office": ["office.n.01!", "home_office.n.01", "study.n.05", "workroom.n.01"],
+    "hallway": ["corridor.n.01", "foyer.n.01"],
+}
+
+
+def _rooms(wn: Any, forms: dict[str, str], noun_exceptions: list[str]) -> dict[str, str]:
+    """Room word -> CapNav room type: the lemmas of ``ROOM_ROOTS`` and their hyponyms whose most
+    frequent noun sense lies there ("chamber" is any enclosed space first, "closet" a cupboard,
+    "head" a body part: none is a room word), that are not a category's form ("lavatory" asks for
+    the toilet). A closed compound on "room" is also said in two words ("guestroom", "guest
+    room"), and a room named after a person ("child's room") by that person's synonyms and
+    plural ("kid's room", "children's room", "kids room"), since that is how people write them. A
+    lemma that is also a person's name ("john") is no room word."""
+    plural = {}
+    for line in noun_exceptions:
+        parts = line.split()
+        if len(parts) == 2:
+            plural.setdefault(parts[1].replace("_", " "), parts[0].replace("_", " "))
+    out: dict[str, str] = {}
+    for room, roots in ROOM_ROOTS.items():
+        members = _closure(wn, roots, set())
+        for name in sorted(members):
+            for lemma in wn.synset(name).lemmas():
+                word = _form(lemma.name())
+                senses = wn.synsets(lemma.name(), "n")
+                if (not senses or senses[0].name() not in members or word in forms or word in out
+                        or _is_name(wn, lemma.name())):
+                    continue
+                for variant in _room_variants(wn, word, plural):
+                    out.setdefault(variant, room)
+    return dict(sorted(out.items()))
+
+
+def _room_variants(wn: Any, word: str, plural: dict[str, str]) -> list[str]:
+    """``word`` and the ways it is written: "guestroom" -> "guest room"; "child's room" -> "kid's
+    room", "children's room", "kids room" (the owner's lemmas of its first sense, each singular or
+    plural, with or without the apostrophe)."""
+    out = [word]
+    if word.endswith("room") and len(word) > 4 and " " not in word and "-" not in word:
+        out.append(word[:-4] + " room")
+    head, sep, rest = word.partition("'s ")
+    person = wn.synsets(head, "n")[0] if sep else None
+    if person is not None and person.lexname() == "noun.person":
+        owners = [_form(lem.name()) for lem in person.lemmas()
+                  if "_" not in lem.name() and wn.synsets(lem.name(), "n")[0] == person]
+        for owner in owners:
+            many = plural.get(owner, owner + "s")
+            out += [f"{owner}'s {rest}", f"{owner}s {rest}", f"{many}' {rest}" if many.endswith("s")
+                    else f"{many}'s {rest}", f"{many} {rest}"]
+    return list(dict.fromkeys(out))
 
 
 def _is_name(wn: Any, lemma: str) -> bool:

@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 from capnav.core.categories import NAMES, category
 from capnav.core.errors import InputError
 from capnav.core.grid import OCCUPIED, OccupancyGrid
+from capnav.language.lexicon import load_lexicon
 from capnav.mapping.objects import MapObject
 
 #: Characteristic objects per room type and how strongly each one implies the room.
@@ -43,7 +44,10 @@ ROOM_CUES: dict[str, dict[str, float]] = {
 }
 #: The room type without characteristic objects: requested by name, recognised as no typed room.
 HALLWAY = "hallway"
-ROOM_SYNONYMS: dict[str, str] = {
+#: Room words: WordNet's (the lexicon's ``rooms``: "guest room", "kitchenette", "powder room",
+#: "kid's room") and these, which WordNet lacks or files elsewhere ("lounge" is a sofa first
+#: there, "family room" and "living area" are not in it).
+_OWN_ROOM_WORDS: dict[str, str] = {
     "kitchen": "kitchen", "bedroom": "bedroom", "bed room": "bedroom", "master bedroom": "bedroom",
     "bathroom": "bathroom", "bath room": "bathroom", "restroom": "bathroom", "washroom": "bathroom",
     "living room": "living room", "lounge": "living room", "sitting room": "living room",
@@ -53,6 +57,35 @@ ROOM_SYNONYMS: dict[str, str] = {
     "hallway": HALLWAY, "hall": HALLWAY, "corridor": HALLWAY, "entrance hall": HALLWAY, "entryway": HALLWAY,
     "hall way": HALLWAY, "passage": HALLWAY, "passageway": HALLWAY, "foyer": HALLWAY, "landing": HALLWAY,
 }
+ROOM_SYNONYMS: dict[str, str] = {**load_lexicon().rooms, **_OWN_ROOM_WORDS}
+# The regular reading drops a possessive "'s" before it looks for room words ("kid room").
+ROOM_SYNONYMS.update({k.replace("'s", ""): v for k, v in ROOM_SYNONYMS.items() if "'s" in k})
+#: The most words a room name has ("children's room" is three tokens: children 's room).
+ROOM_MAX_WORDS = 4
+
+
+def _room_key(words: list[str]) -> str:
+    """Words joined as the room names are written: a possessive the tokenizer split off is put
+    back on its word ("kid 's room" -> "kid's room")."""
+    return " ".join(words).replace(" 's ", "'s ").replace(" ' ", "' ")
+
+
+def room_starting(words: list[str], i: int) -> tuple[str, int] | None:
+    """(room type, number of words) of the longest room name starting at word ``i``."""
+    for n in range(min(ROOM_MAX_WORDS, len(words) - i), 0, -1):
+        room = ROOM_SYNONYMS.get(_room_key(words[i:i + n]))
+        if room is not None:
+            return room, n
+    return None
+
+
+def room_ending(words: list[str], j: int) -> tuple[str, int] | None:
+    """(room type, number of words) of the longest room name ending just before word ``j``."""
+    for n in range(min(ROOM_MAX_WORDS, j), 0, -1):
+        room = ROOM_SYNONYMS.get(_room_key(words[j - n:j]))
+        if room is not None:
+            return room, n
+    return None
 
 
 @dataclass(frozen=True)
@@ -338,5 +371,5 @@ def canonical_room(text: str) -> str | None:
     return ROOM_SYNONYMS.get(text.strip().lower())
 
 
-__all__ = ["CACHE_KEY", "HALLWAY", "NAMES", "ROOM_CUES", "ContextConfig", "SceneContext", "canonical_label",
-           "canonical_room", "label_of"]
+__all__ = ["CACHE_KEY", "HALLWAY", "NAMES", "ROOM_CUES", "ROOM_SYNONYMS", "ContextConfig", "SceneContext",
+           "canonical_label", "canonical_room", "label_of", "room_ending", "room_starting"]

@@ -59,6 +59,8 @@ class Lexicon:
     #: a height word ("tall", "stumpy", "lower") -> "large" / "small"; "tallest", "lowest" ->
     #: "largest" / "smallest" (WordNet's, see build_lexicon): compared with the mapped heights
     heights: dict[str, str] = field(default_factory=dict)
+    #: room word -> room type (WordNet's rooms, see build_lexicon): "guest room", "kitchenette"
+    rooms: dict[str, str] = field(default_factory=dict)
     height_superlatives: dict[str, str] = field(default_factory=dict)
     load_seconds: float = 0.0
 
@@ -98,7 +100,8 @@ def load_lexicon() -> Lexicon:
                   kinds={k: tuple(v) for k, v in raw.get("kinds", {}).items()},
                   placing=frozenset(raw.get("placing", [])), body=frozenset(raw.get("body", [])),
                   materials=dict(raw.get("materials", {})), heights=dict(raw.get("heights", {})),
-                  height_superlatives=dict(raw.get("height_superlatives", {})))
+                  height_superlatives=dict(raw.get("height_superlatives", {})),
+                  rooms=dict(raw.get("rooms", {})))
     object.__setattr__(lex, "load_seconds", time.perf_counter() - t0)
     return lex
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from capnav.language.context import ROOM_SYNONYMS
+from capnav.language.context import room_ending, room_starting
 from capnav.retrieval.query.tokens import _ORDINALS, _find_category
 
 #: Cardinal words of a count ("number three", "skip the first two").
@@ -35,7 +35,6 @@ _NUMBER = re.compile(r"\b(?:number|no)\s+(?P<k>one|two|three|four|five|[1-5])\b"
 #: Words before an ordinal word that make it something else: "for a second", "at first".
 _NOT_ORDINAL_BEFORE = {"a", "at", "for"}
 _NOT_ORDINAL_AFTER = {"of", "time", "floor", "place", "hand"}
-_ROOMS = sorted(ROOM_SYNONYMS, key=len, reverse=True)
 
 
 @dataclass
@@ -54,24 +53,6 @@ class Count:
     spans: list[tuple[int, int]] = field(default_factory=list)  # character spans read (to remove)
 
 
-def _room_at(words: list[str], i: int) -> tuple[str, int] | None:
-    """(room, words) of a room name starting at word ``i``."""
-    for n in (2, 1):
-        gram = " ".join(words[i:i + n])
-        if i + n <= len(words) and gram in ROOM_SYNONYMS:
-            return ROOM_SYNONYMS[gram], n
-    return None
-
-
-def _room_ending_at(words: list[str], j: int) -> tuple[str, int] | None:
-    """(room, words) of a room name ending just before word ``j``."""
-    for n in (2, 1):
-        gram = " ".join(words[j - n:j])
-        if j - n >= 0 and gram in ROOM_SYNONYMS:
-            return ROOM_SYNONYMS[gram], n
-    return None
-
-
 def door_room(words: list[str]) -> tuple[str | None, str | None, int] | None:
     """(room behind the door, room it belongs to, words used) of a door phrase at the start of
     ``words``: "hall door", "office hall door" (the office's), "door to the landing", "kitchen
@@ -79,14 +60,14 @@ def door_room(words: list[str]) -> tuple[str | None, str | None, int] | None:
     k = next((i for i, w in enumerate(words[:5]) if w in DOORS), None)
     if k is None:
         return None
-    behind = _room_ending_at(words, k)
-    owner = _room_ending_at(words, k - behind[1]) if behind else None
+    behind = room_ending(words, k)
+    owner = room_ending(words, k - behind[1]) if behind else None
     used = k + 1
     after = words[k + 1:k + 5]
     if behind is None and after and after[0] in ("to", "into", "of", "from", "for", "onto", "leading"):
         j = 1 + int(after[1:2] == ["to"]) if after[0] == "leading" else 1
         j += int(after[j:j + 1] in (["the"], ["a"], ["my"], ["your"], ["our"]))
-        found = _room_at(after, j)
+        found = room_starting(after, j)
         if found is not None:
             behind = found
             used = k + 1 + j + found[1]
@@ -131,7 +112,7 @@ def read_count(text: str) -> Count:
             c.origin_room, c.door_owner = behind, owner
         elif c.ordinal is None:
             continue
-        elif (room := _room_at(rest, 0)) is not None and not _names_object_after(rest, room[1]):
+        elif (room := room_starting(rest, 0)) is not None and not _names_object_after(rest, room[1]):
             c.origin_room, used = room  # "walking in from the hall"
         else:
             cat, span, _ = _find_category(rest[:4])

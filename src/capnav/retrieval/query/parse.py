@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from capnav.core.errors import pip_hint
-from capnav.language.context import ROOM_SYNONYMS
+from capnav.language.context import room_starting
 from capnav.language.purpose import find_activity
 from capnav.retrieval.query.tokens import _FORM_MAP, _find_category, attribute_word
 
@@ -303,12 +303,10 @@ def _room_mentions(doc: Doc) -> list[tuple[int, int, str]]:
     out = []
     i = 0
     while i < len(toks):
-        for n in (2, 1):
-            gram = " ".join(toks[i:i + n])
-            if i + n <= len(toks) and gram in ROOM_SYNONYMS and doc[i + n - 1].pos_ in ("NOUN", "PROPN"):
-                out.append((i, i + n, ROOM_SYNONYMS[gram]))
-                i += n
-                break
+        found = room_starting(toks, i)
+        if found and doc[i + found[1] - 1].pos_ in ("NOUN", "PROPN"):
+            out.append((i, i + found[1], found[0]))
+            i += found[1]
         else:
             i += 1
     return out

@@ -22,7 +22,7 @@ from rapidfuzz.distance import OSA
 from capnav.core.categories import CATEGORIES
 from capnav.core.errors import InputError
 from capnav.language.colors import ALIASES, LEXICON, SHADES, canonical_color, color_lab
-from capnav.language.context import ROOM_SYNONYMS
+from capnav.language.context import room_ending
 from capnav.language.lexicon import load_lexicon
 from capnav.retrieval.query.model import END_OF
 
@@ -378,12 +378,8 @@ _ORDINALS = {"first": 1, "1st": 1, "second": 2, "2nd": 2, "third": 3, "3rd": 3, 
 
 def _room_before(words: list[str], start: int) -> tuple[str | None, int]:
     """A room named just before the target noun ("the office lamp"): (room, its first word)."""
-    for n in (2, 1):
-        if start - n >= 0:
-            gram = " ".join(words[start - n:start])
-            if gram in ROOM_SYNONYMS:
-                return ROOM_SYNONYMS[gram], start - n
-    return None, start
+    found = room_ending(words, start)
+    return (found[0], start - found[1]) if found else (None, start)
 
 
 def _size_word(words: list[str]) -> tuple[str | None, str | None]:
