@@ -157,3 +157,14 @@ def test_a_door_of_the_room_in_a_parsed_sentence(retriever: Retriever) -> None:
 ])
 def test_farthest_from_a_door_reverses_the_order_from_the_way_in(retriever: Retriever, text: str, oid: int) -> None:
     assert _answer(retriever, text) == oid
+
+
+# -- "nearest the X door" is the first met from that door, as "furthest from" is the last --------
+@pytest.mark.parametrize(("text", "oid"), [
+    ("the bookshelf nearest the corridor door", 31),
+    ("the plant closest to the kitchen door", 21),
+    ("take me to the bookshelf that is nearest to the office door", 31),
+])
+def test_nearest_a_door_is_the_first_from_the_way_in(retriever: Retriever, text: str, oid: int) -> None:
+    assert _answer(retriever, text) == oid
+    assert not parse_instruction(text).unknown_words

@@ -28,6 +28,10 @@ DOORS = {"door", "doorway", "doors", "entrance", "entry", "archway", "opening", 
 _START = re.compile(r"\b(?:(?:start|starting|started|begin|beginning|count|counting|work|working)\s+"
                     r"(?:off\s+)?(?:at|from|by|with|beside|next\s+to)|from)\s+(?:the\s+|a\s+|an\s+|my\s+|your\s+|our\s+)?")
 #: "pass the closest lamp and take the next", "skip the first two and take the one after".
+#: "the chair nearest the hall door", "closest to the kitchen door": the order from that door,
+#: as "furthest from the hall door" reverses it (a door only; "nearest the sofa" is a landmark's
+#: proximity, read with the other landmarks).
+_NEAR = re.compile(r"\b(?:closest|nearest)\s+(?:to\s+)?(?:the\s+|a\s+|an\s+|my\s+|your\s+|our\s+)?")
 _SKIP = re.compile(r"\b(?:skip|skipping|pass|passing|ignore|ignoring|miss|missing|bypass|go\s+past|walk\s+past|past)"
                    r"\s+(?:the\s+)?(?:(?P<which>first|nearest|closest)\s+)?(?:(?P<k>one|two|three|four|[1-4])\s+)?")
 _NEXT = re.compile(r"\b(?:the\s+)?(?:next(?!\s+to\b)(?:\s+one)?|one\s+after(?:\s+that)?|following\s+one)\b")
@@ -102,7 +106,8 @@ def read_count(text: str) -> Count:
     door, the lamp on your left"); a landmark or a room one starts from only with an ordinal."""
     c = Count()
     c.ordinal, c.skipped_nearest, c.spans = read_ordinal(text)
-    for m in _START.finditer(text):
+    starts = [(m, False) for m in _START.finditer(text)] + [(m, True) for m in _NEAR.finditer(text)]
+    for m, near in sorted(starts, key=lambda s: s[0].start()):
         rest = text[m.end():].split()
         door = door_room(rest)
         if door is not None:
@@ -110,7 +115,7 @@ def read_count(text: str) -> Count:
             if behind is None:
                 continue  # "from the door": which door is not said
             c.origin_room, c.door_owner = behind, owner
-        elif c.ordinal is None:
+        elif near or c.ordinal is None:
             continue
         elif (room := room_starting(rest, 0)) is not None and not _names_object_after(rest, room[1]):
             c.origin_room, used = room  # "walking in from the hall"
