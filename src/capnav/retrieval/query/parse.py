@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 from capnav.core.errors import pip_hint
 from capnav.language.context import room_starting
 from capnav.language.purpose import find_activity
+from capnav.retrieval.query.count import DOORS
 from capnav.retrieval.query.tokens import _FORM_MAP, _find_category, attribute_word
 
 if TYPE_CHECKING:
@@ -59,7 +60,6 @@ _LANDMARK_PREPS = {"to", "by", "beside", "besides", "near", "behind", "opposite"
 _GOAL_PREPS = {"to", "towards", "toward", "into", "onto", "on", "at", "over", "in", "inside", "for", "with"}
 #: Where a room stands in a route: the target's own room, where one comes from, what one passes.
 _ROOM_ORIGIN = {"from", "out", "leaving", "leave", "exit", "exiting", "door"}
-_DOORS = {"door", "doorway", "entrance", "entry", "archway", "opening", "doors"}
 _DOOR_PREPS = {"to", "into", "of", "from", "for", "onto"}
 _ROOM_PASSED = {"through", "past", "via", "across"}
 _ROOM_DEST = {"into", "to", "towards", "toward", "entering", "enter", "onto"}
@@ -344,11 +344,11 @@ def _is_landmark(t: Token) -> bool:
 def _governor(t: Token) -> str:
     """The preposition or verb that governs a room noun, with "out of" read as one word."""
     h = t.head
-    if (t.dep_ == "pobj" and h.head.lower_ in _DOORS) or (t.dep_ == "compound" and h.lower_ in _DOORS):
+    if (t.dep_ == "pobj" and h.head.lower_ in DOORS) or (t.dep_ == "compound" and h.lower_ in DOORS):
         return "door"  # "the door to the landing", "the landing door": the room on the door's other side
-    if t.i + 1 < len(t.doc) and t.doc[t.i + 1].lower_ in _DOORS:
+    if t.i + 1 < len(t.doc) and t.doc[t.i + 1].lower_ in DOORS:
         return "door"  # "the bathroom door" however the parser attached the two nouns
-    if t.dep_ == "pobj" and h.i > 0 and h.lower_ in _DOOR_PREPS and t.doc[h.i - 1].lower_ in _DOORS:
+    if t.dep_ == "pobj" and h.i > 0 and h.lower_ in _DOOR_PREPS and t.doc[h.i - 1].lower_ in DOORS:
         # "the third stool from the door to the hall" with "to the hall" hung on the stool by
         # the parser: a room right after "door to" is still the door's other side.
         return "door"
