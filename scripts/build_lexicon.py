@@ -197,16 +197,17 @@ def build(wordnet: Path) -> dict[str, Any]:
     with tempfile.TemporaryDirectory() as tmp:
         wn = open_wordnet(wordnet, Path(tmp))
         out = _build(wn)
+        noun_exc = (wordnet / "noun.exc").read_text().splitlines()
         out["sizes"] = _sizes(wn, (wordnet / "adj.exc").read_text().splitlines())
         out["heights"], out["height_superlatives"] = _heights(wn, out["sizes"])
         out["growth"] = _growth(wn, out["forms"])
         out["labels"] = _labels(wn, out["forms"])
-        out["persons"] = _persons(wn, (wordnet / "noun.exc").read_text().splitlines())
+        out["persons"] = _persons(wn, noun_exc)
         out["kinds"] = _kinds(wn, out["forms"])
         out["placing"] = _placing(wn)
-        out["body"] = _body(wn, (wordnet / "noun.exc").read_text().splitlines())
+        out["body"] = _body(wn, noun_exc)
         out["materials"] = _materials(wn, out["forms"], out["labels"])
-        out["rooms"] = _rooms(wn, out["forms"], (wordnet / "noun.exc").read_text().splitlines())
+        out["rooms"] = _rooms(wn, out["forms"], noun_exc)
         out["forms"] = dict(sorted(out["forms"].items()))
         return out
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -70,13 +71,18 @@ def _room_key(words: list[str]) -> str:
     return " ".join(words).replace(" 's ", "'s ").replace(" ' ", "' ")
 
 
-def room_starting(words: list[str], i: int) -> tuple[str, int] | None:
-    """(room type, number of words) of the longest room name starting at word ``i``."""
+def rooms_starting(words: list[str], i: int) -> Iterator[tuple[str, int]]:
+    """(room type, number of words) of every room name starting at word ``i``, longest first
+    ("hall way", then "hall"), for a reader that checks more than the words."""
     for n in range(min(ROOM_MAX_WORDS, len(words) - i), 0, -1):
         room = ROOM_SYNONYMS.get(_room_key(words[i:i + n]))
         if room is not None:
-            return room, n
-    return None
+            yield room, n
+
+
+def room_starting(words: list[str], i: int) -> tuple[str, int] | None:
+    """(room type, number of words) of the longest room name starting at word ``i``."""
+    return next(rooms_starting(words, i), None)
 
 
 def room_ending(words: list[str], j: int) -> tuple[str, int] | None:
@@ -372,4 +378,4 @@ def canonical_room(text: str) -> str | None:
 
 
 __all__ = ["CACHE_KEY", "HALLWAY", "NAMES", "ROOM_CUES", "ROOM_SYNONYMS", "ContextConfig", "SceneContext",
-           "canonical_label", "canonical_room", "label_of", "room_ending", "room_starting"]
+           "canonical_label", "canonical_room", "label_of", "room_ending", "room_starting", "rooms_starting"]

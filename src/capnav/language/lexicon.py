@@ -59,9 +59,9 @@ class Lexicon:
     #: a height word ("tall", "stumpy", "lower") -> "large" / "small"; "tallest", "lowest" ->
     #: "largest" / "smallest" (WordNet's, see build_lexicon): compared with the mapped heights
     heights: dict[str, str] = field(default_factory=dict)
+    height_superlatives: dict[str, str] = field(default_factory=dict)
     #: room word -> room type (WordNet's rooms, see build_lexicon): "guest room", "kitchenette"
     rooms: dict[str, str] = field(default_factory=dict)
-    height_superlatives: dict[str, str] = field(default_factory=dict)
     load_seconds: float = 0.0
 
     def category_alternatives(self, category: str, form: str | None = None) -> dict[str, float]:

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from capnav.core.errors import pip_hint
-from capnav.language.context import room_starting
+from capnav.language.context import rooms_starting
 from capnav.language.purpose import find_activity
 from capnav.retrieval.query.count import DOORS
 from capnav.retrieval.query.tokens import _FORM_MAP, _find_category, attribute_word
@@ -303,8 +303,9 @@ def _room_mentions(doc: Doc) -> list[tuple[int, int, str]]:
     out = []
     i = 0
     while i < len(toks):
-        found = room_starting(toks, i)
-        if found and doc[i + found[1] - 1].pos_ in ("NOUN", "PROPN"):
+        # The longest room name that ends on a noun ("the hall way" read as a room, not "hall").
+        found = next((f for f in rooms_starting(toks, i) if doc[i + f[1] - 1].pos_ in ("NOUN", "PROPN")), None)
+        if found:
             out.append((i, i + found[1], found[0]))
             i += found[1]
         else:
