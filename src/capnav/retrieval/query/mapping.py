@@ -17,7 +17,7 @@ from capnav.language.context import ROOM_SYNONYMS
 from capnav.language.purpose import find_activity, match_purpose, purpose_categories
 from capnav.retrieval.query.count import read_count, without
 from capnav.retrieval.query.model import ACROSS, BETWEEN, ROOM_WITH, ParsedQuery
-from capnav.retrieval.query.parse import _GENERIC, GoalParse, describe
+from capnav.retrieval.query.parse import _GENERIC, ROOM_ALONG, GoalParse, describe
 from capnav.retrieval.query.tokens import (
     _COMMON_ADJECTIVES,
     _FILLER,
@@ -417,12 +417,14 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     # An ordinal and where it counts from: "the second stool from the fridge", "number two from
     # the hall door", "pass the closest lamp and take the next".
     head = _count(q, head)
-    # Room: "in the kitchen", "in the living room".
+    # Room: "in the kitchen", "in the living room", and a room walked along ("down the hall"):
+    # the parse's reading of the same words (``ROOM_ALONG``), for requests too short to parse.
+    preps = "|".join(("in", "inside", "within", "from", "of", *ROOM_ALONG))
     for phrase in sorted(ROOM_SYNONYMS, key=len, reverse=True):
         if phrase not in head:  # cheap test first: a one-shot query compiles only the patterns it needs
             continue
         # Not when the room word modifies an object noun ("at the end of the kitchen counter").
-        pat = rf"\b(?:in|inside|within|from|of)\s+(?:the\s+|my\s+|our\s+)?{re.escape(phrase)}\b"
+        pat = rf"\b(?:{preps})\s+(?:the\s+|my\s+|our\s+)?{re.escape(phrase)}\b"
         m = next((m for m in re.finditer(pat, head) if not _form_follows(head, m.end())), None)
         if m:
             q.room = ROOM_SYNONYMS[phrase]

@@ -65,7 +65,7 @@ _ROOM_PASSED = {"through", "past", "via", "across"}
 _ROOM_DEST = {"into", "to", "towards", "toward", "entering", "enter", "onto"}
 #: A room one walks along ("down the hallway", "along the corridor"): where the target stands
 #: unless the route also names a room it goes into.
-_ROOM_ALONG = {"along", "down", "up"}
+ROOM_ALONG = ("along", "down", "up")
 #: Verbs that start a count or a route at an object ("start at the TV", "beginning by the fridge"):
 #: their object is where one starts, a landmark, not the goal.
 _START_VERBS = {"start", "begin", "count"}
@@ -359,7 +359,7 @@ def _governor(t: Token) -> str:
             return "out"
         return w
     if t.dep_ in ("dobj", "npadvmod") and h.pos_ == "VERB":
-        prt = next((c.lower_ for c in h.children if c.dep_ == "prt" and c.lower_ in _ROOM_ALONG), None)
+        prt = next((c.lower_ for c in h.children if c.dep_ == "prt" and c.lower_ in ROOM_ALONG), None)
         return prt or h.lemma_.lower() or h.text.lower()  # "walking down the hallway": along it
     if t.dep_ == "compound":
         return "compound"
@@ -518,7 +518,7 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
     for s, e, room in rooms:
         gov = _governor(_span_head(doc, s, e))
         role = "origin" if gov in _ROOM_ORIGIN else "passed" if gov in _ROOM_PASSED else \
-            "along" if gov in _ROOM_ALONG else "target"
+            "along" if gov in ROOM_ALONG else "target"
         g.rooms.append((role, room))
         if role == "origin" and g.origin_room is None:
             g.origin_room = room
@@ -702,7 +702,8 @@ def _describes_target(t: Token, head: Token) -> bool:
 
 def _words(doc: Doc, keep: set[int], rooms: list[tuple[int, int, str]], refs: dict[int, str] | None = None) -> str:
     """The kept words in their order, a space wherever a word was left out; a destination room
-    ("into the lounge") reads as where the target stands ("in the lounge"); a pronoun of ``refs``
+    ("into the lounge", "enter the lounge") reads as where the target stands ("in the lounge"); a
+    pronoun of ``refs``
     as the object it stands for."""
     out: list[str] = []
     dest = set()
@@ -710,6 +711,8 @@ def _words(doc: Doc, keep: set[int], rooms: list[tuple[int, int, str]], refs: di
         rh = _span_head(doc, s, e)
         if rh.dep_ == "pobj" and rh.head.text.lower() in _ROOM_DEST and _governor(rh) != "door":
             dest.add(rh.head.i)
+        elif rh.dep_ == "dobj" and _governor(rh) in _ROOM_DEST:
+            dest.add(rh.head.i)  # "as you enter the kitchen": the verb reads as "in"
     for t in doc:
         if t.i not in keep:
             continue

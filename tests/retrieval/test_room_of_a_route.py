@@ -1,0 +1,54 @@
+"""A room named by the verb or the preposition of a route is where the target stands: "as you enter
+the kitchen", "when you come into the lounge", "along the corridor", "down the hall". The room
+is the object of a verb of entering or of a preposition one walks along, not of "in"; it must
+not become unknown words. Scene and sentences written for these tests, none from the
+development phrasings."""
+
+from __future__ import annotations
+
+import pytest
+
+from capnav.retrieval import Retriever
+from capnav.retrieval.query import parse_instruction
+from language.synth import grid_with_wall, make_obj, offline_retriever
+
+
+@pytest.fixture(scope="module")
+def retriever() -> Retriever:
+    objs = [
+        make_obj(1, "bed", (1.0, 1.5), (1.6, 2.0, 0.5), (200, 200, 210)),
+        make_obj(2, "lamp", (2.5, 4.5), (0.3, 0.3, 1.5), (230, 230, 220)),
+        make_obj(3, "sofa", (6.5, 1.0), (2.0, 0.9, 0.8), (90, 90, 100)),
+        make_obj(4, "tv", (6.5, 5.5), (1.0, 0.2, 0.6), (20, 20, 20)),
+        make_obj(5, "lamp", (5.0, 4.5), (0.3, 0.3, 1.5), (230, 230, 220)),
+    ]
+    return offline_retriever(objs, grid_with_wall(-1, -1, 9, 7, wall_x=4.0, door=(2.5, 3.5)))
+
+
+@pytest.mark.parametrize(("text", "room"), [
+    ("the first chair as you enter the kitchen", "kitchen"),
+    ("the first chair on the right as you enter the living room", "living room"),
+    ("the bed you see when you enter the guest room", "bedroom"),
+    ("the lamp along the corridor", "hallway"),
+    ("the third plant along the hallway", "hallway"),
+    ("the lamp down the hall", "hallway"),
+])
+def test_a_route_room_is_where_the_target_stands(text: str, room: str) -> None:
+    q = parse_instruction(text)
+    assert q.room == room, vars(q)
+    assert not set(q.unknown_words) & {"enter", "kitchen", "living", "corridor", "hallway", "hall", "along",
+                                       "down", "guest"}, vars(q)
+
+
+def test_a_room_walked_through_is_not_where_the_target_stands() -> None:
+    q = parse_instruction("the lamp you pass when you walk through the kitchen into the lounge")
+    assert q.room == "living room", vars(q)
+
+
+@pytest.mark.parametrize(("text", "oid"), [
+    ("take me to the lamp as you enter the living room", 5),
+    ("the lamp you see as you enter the bedroom", 2),
+])
+def test_the_entered_room_chooses_the_object(retriever: Retriever, text: str, oid: int) -> None:
+    res = retriever.query(text)
+    assert res.found and res.chosen is not None and res.chosen.id == oid, res.reason
