@@ -52,3 +52,25 @@ def test_a_room_walked_through_is_not_where_the_target_stands() -> None:
 def test_the_entered_room_chooses_the_object(retriever: Retriever, text: str, oid: int) -> None:
     res = retriever.query(text)
     assert res.found and res.chosen is not None and res.chosen.id == oid, res.reason
+
+
+@pytest.mark.parametrize(("text", "room"), [
+    ("the lamp in the main bedroom", "bedroom"),
+    ("the dresser opposite the bed in the main bedroom", "bedroom"),
+    ("the sink in the upstairs bathroom", "bathroom"),
+    ("the chair in the blue bedroom", "bedroom"),
+    ("the lamp in the second bedroom", "bedroom"),
+    ("the plant in our big kitchen", "kitchen"),
+])
+def test_words_before_a_room_name_describe_the_room(text: str, room: str) -> None:
+    """An adjective or ordinal on the room ("the main bedroom", "the blue bedroom", "the second
+    bedroom") belongs to the room: the room is kept and the word is not the target's."""
+    q = parse_instruction(text)
+    assert q.room == room, vars(q)
+    assert not q.colors and q.ordinal is None and q.size_word is None, vars(q)
+    assert not set(q.unknown_words) & {"bedroom", "bathroom", "kitchen"}, vars(q)
+
+
+def test_an_ordinal_before_a_room_word_that_names_an_object_counts_the_object() -> None:
+    q = parse_instruction("the first kitchen chair")
+    assert q.ordinal == 1, vars(q)

@@ -96,6 +96,8 @@ def read_ordinal(text: str) -> tuple[int | None, bool, list[tuple[int, int]]]:
         after = words[k + 1].group() if k + 1 < len(words) else ""
         if before in _NOT_ORDINAL_BEFORE or after in _NOT_ORDINAL_AFTER:
             continue
+        if _room_after(words, k + 1):
+            continue  # "in the second bedroom", "the first small bathroom": the room's, not the target's
         return _ORDINALS[w.group()], False, []
     return None, False, []
 
@@ -128,6 +130,17 @@ def read_count(text: str) -> Count:
         c.spans.append((m.start(), end))
         break
     return c
+
+
+def _room_after(words: list[re.Match[str]], i: int) -> bool:
+    """A room name starts at word ``i`` or the one after it and names no object with the word
+    after it ("the second bedroom", but "the first kitchen chair" counts chairs)."""
+    toks = [w.group() for w in words]
+    for j in (i, i + 1):
+        found = room_starting(toks, j) if j < len(toks) else None
+        if found is not None and not _names_object_after(toks, j + found[1]):
+            return True
+    return False
 
 
 def _names_object_after(words: list[str], n: int) -> bool:

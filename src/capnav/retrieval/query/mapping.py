@@ -86,6 +86,10 @@ _CLAUSE_VERB = re.compile(r"\b(?:is|are|was|were|sits|sit|stands|stand|rests|lie
 
 
 _ARTICLE = r"(?:the\s+|a\s+|an\s+|my\s+|our\s+|your\s+)?"
+#: Words that may describe a room before its name: not a preposition, article or conjunction
+#: (which would start another phrase) and not an object's name (the room's own words come after).
+_ROOM_MODIFIERS = r"(?:(?!(?:in|on|at|of|by|to|from|near|next|with|and|or|the|a|an|my|our|your|this|that)\b)" \
+    r"[a-z][a-z'-]*\s+){0,2}"
 _ROOM_ALT = "|".join(re.escape(r) for r in sorted(ROOM_SYNONYMS, key=len, reverse=True))
 
 
@@ -419,12 +423,14 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     head = _count(q, head)
     # Room: "in the kitchen", "in the living room", and a room walked along ("down the hall"):
     # the parse's reading of the same words (``ROOM_ALONG``), for requests too short to parse.
+    # Up to two words between the article and the room name describe the room ("the main
+    # bedroom", "the blue bedroom", "the second bedroom"): they go with it, never to the target.
     preps = "|".join(("in", "inside", "within", "from", "of", *ROOM_ALONG))
     for phrase in sorted(ROOM_SYNONYMS, key=len, reverse=True):
         if phrase not in head:  # cheap test first: a one-shot query compiles only the patterns it needs
             continue
         # Not when the room word modifies an object noun ("at the end of the kitchen counter").
-        pat = rf"\b(?:{preps})\s+(?:the\s+|my\s+|our\s+)?{re.escape(phrase)}\b"
+        pat = rf"\b(?:{preps})\s+(?:the\s+|my\s+|our\s+)?{_ROOM_MODIFIERS}{re.escape(phrase)}\b"
         m = next((m for m in re.finditer(pat, head) if not _form_follows(head, m.end())), None)
         if m:
             q.room = ROOM_SYNONYMS[phrase]
