@@ -50,3 +50,30 @@ def test_an_absent_thing_over_a_landmark_is_not_found(retriever: Retriever, text
 def test_a_thing_above_or_below_a_landmark_is_the_one_touching_it(retriever: Retriever, text: str, oid: int) -> None:
     res = retriever.query(text)
     assert res.found and res.chosen is not None and res.chosen.id == oid, res.reason
+
+
+@pytest.mark.parametrize(("text", "anchor"), [
+    ("the lamp on the desk", "desk"),
+    ("the vase on the table", "table"),
+    ("the plant sitting on the bookshelf", "bookshelf"),
+    ("take me to the cup on the kitchen counter", "counter"),
+])
+def test_on_a_landmark_is_a_relation(text: str, anchor: str) -> None:
+    """"on the desk" is where the thing stands: the desk is a landmark, never an unknown word."""
+    q = parse_instruction(text)
+    assert q.relation == "on top of" and q.anchor_category == anchor, vars(q)
+    assert anchor not in q.unknown_words, vars(q)
+
+
+@pytest.mark.parametrize(("text", "side"), [
+    ("the lamp on the left", "left"),
+    ("the stool on your right", "right"),
+])
+def test_on_a_side_is_no_landmark(text: str, side: str) -> None:
+    q = parse_instruction(text)
+    assert q.relation is None and q.anchor_category is None, vars(q)
+
+
+def test_the_lamp_on_the_desk_is_the_one_standing_on_it(retriever: Retriever) -> None:
+    res = retriever.query("the lamp on the desk")
+    assert res.found and res.chosen is not None and res.chosen.id == 3, res.reason

@@ -280,9 +280,12 @@ def _clause_landmark(q: ParsedQuery, head: str) -> str:
 
 def relation_name(rel: str) -> str:
     """The relation a phrase says: "beside", "by", "close to" are "next to"; "on the left-hand side
-    of", "to the left of" are "left of" (and right); the others as said."""
+    of", "to the left of" are "left of" (and right); "on" and "atop" are "on top of"; the others as
+    said."""
     if rel in ("besides", "beside", "by", "close to", "alongside"):
         return "next to"
+    if rel in ("on", "atop"):
+        return "on top of"
     for side in ("left", "right"):
         if rel.endswith(" of") and side in rel.split() + rel.replace("-", " ").split():
             return f"{side} of"
@@ -467,6 +470,8 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     if q.anchor_category is None:
         for rel in _RELATIONS:
             m = re.search(rf"\b{rel}\s+(?:the\s+|a\s+|an\s+|my\s+)?(.+)$", head) if rel in head else None
+            if m and rel == "on" and _find_category(head[:m.start()].split())[0] is None:
+                continue  # "sit on the armchair", "put the sheets on the bed": the place of a verb, the goal
             if m and m.start() > 0:
                 anchor_words = m.group(1).split()
                 cat, _, _ = _find_category(anchor_words)

@@ -144,10 +144,12 @@ _RELATIONS = [END_OF, "in front of", "facing", "next to", "close to", "beside", 
               # above or below the landmark: on the floor plan the two touch (ranked by the gap
               # between footprints, as "next to"); the thing hung over a sink is not the sink
               "on top of", "above", "below", "underneath", "beneath", "under", "atop",
+              # standing on the landmark ("the vase on the table"): "on top of"; tried after every
+              # longer relation that starts with it ("on the left of")
               # a side of the landmark, as the speaker sees it ("the chair to the left of the desk")
               *(f"{prep}{side} of" for side in ("left", "right", "left-hand side", "right-hand side", "left side",
                                                 "right side", "left hand side", "right hand side")
-                for prep in ("to the ", "on the ", "at the ", ""))]
+                for prep in ("to the ", "on the ", "at the ", "")), "on"]
 _MATERIALS = {"wooden", "wood", "leather", "fabric", "velvet", "metal", "glass", "marble", "plastic",
               "ceramic", "stainless", "steel", "laminate", "cotton", "acrylic", "paper", "terracotta", "chrome"}
 #: Every other material word WordNet has, spoken as the material the surface test knows
