@@ -77,3 +77,14 @@ def test_on_a_side_is_no_landmark(text: str, side: str) -> None:
 def test_the_lamp_on_the_desk_is_the_one_standing_on_it(retriever: Retriever) -> None:
     res = retriever.query("the lamp on the desk")
     assert res.found and res.chosen is not None and res.chosen.id == 3, res.reason
+
+
+@pytest.mark.parametrize(("text", "goal"), [
+    ("I put my phone down on the nightstand, can you go there", "nightstand"),
+    ("we placed the keys on the coffee table, take me to it", "coffee table"),
+    ("she set her mug on the counter earlier", "counter"),
+])
+def test_on_after_putting_something_down_is_where_it_was_put(text: str, goal: str) -> None:
+    """The place something was put down on is the goal, not a landmark of the thing put."""
+    q = parse_instruction(text)
+    assert q.category == goal and q.relation is None, vars(q)

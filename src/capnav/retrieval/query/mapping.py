@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 from capnav.core.categories import BY_NAME
 from capnav.language.colors import ALIASES, LEXICON
 from capnav.language.context import ROOM_SYNONYMS
-from capnav.language.purpose import find_activity, match_purpose, purpose_categories
+from capnav.language.purpose import find_activity, is_placing, match_purpose, purpose_categories
 from capnav.retrieval.query.count import read_count, without
 from capnav.retrieval.query.model import ACROSS, BETWEEN, ROOM_WITH, ParsedQuery
 from capnav.retrieval.query.parse import _GENERIC, ROOM_ALONG, GoalParse, describe
@@ -278,6 +278,13 @@ def _clause_landmark(q: ParsedQuery, head: str) -> str:
     return " ".join(words[: span[1]])
 
 
+def _put_down(words: list[str]) -> bool:
+    """Whether ``words`` hold a verb of putting a thing down (the lexicon's placing verbs,
+    WordNet's, in any inflection): what follows "on" is where it was put."""
+    return any(is_placing(" ".join(words[i:i + 2])) or (w.endswith("ed") and is_placing(w[:-1]))
+               or (w.endswith("ed") and is_placing(w[:-2])) for i, w in enumerate(words))
+
+
 def relation_name(rel: str) -> str:
     """The relation a phrase says: "beside", "by", "close to" are "next to"; "on the left-hand side
     of", "to the left of" are "left of" (and right); "on" and "atop" are "on top of"; the others as
@@ -407,11 +414,14 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     and no category."""
     t = validate_instruction(text)
     low = t.lower()
-    norm = re.sub(r"[^a-z0-9\-' ]+", " ", low)
+    # Commas and semicolons stay until the negations are read: a negated phrase ends at one
+    # ("not the one in the office, the one in the bedroom").
+    norm = re.sub(r"[^a-z0-9\-',; ]+", " ", low).replace(",", " , ").replace(";", " ; ")
     norm = re.sub(r"\b(\w+)n't\b", r"\1 not", norm.replace("isn't", "is not").replace("isnt", "is not"))
     norm = " ".join(_fix_keyword_typos(norm.replace("'s", "").split()))
     q = ParsedQuery(text=t)
-    head = _negations(q, norm)
+    head = " ".join(re.sub(r"[,;]", " ", _negations(q, norm)).split())
+    norm = " ".join(re.sub(r"[,;]", " ", norm).split())
     # "somewhere to rest my plate while we watch the tv": the tv is where, not what.
     head = _purpose_context(q, head)
     # "somewhere right by the bed to put my glass": the landmark of the place asked for.
@@ -470,8 +480,11 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     if q.anchor_category is None:
         for rel in _RELATIONS:
             m = re.search(rf"\b{rel}\s+(?:the\s+|a\s+|an\s+|my\s+)?(.+)$", head) if rel in head else None
+            if m and rel == "on" and _put_down(head[:m.start()].split()):
+                head = m.group(1)  # "I put my mug down on the counter": where it was put is the goal
+                break
             if m and rel == "on" and _find_category(head[:m.start()].split())[0] is None:
-                continue  # "sit on the armchair", "put the sheets on the bed": the place of a verb, the goal
+                continue  # "sit on the armchair", "read on the bed": the place of a verb, the goal
             if m and m.start() > 0:
                 anchor_words = m.group(1).split()
                 cat, _, _ = _find_category(anchor_words)
