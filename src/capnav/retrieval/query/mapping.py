@@ -285,6 +285,17 @@ def _put_down(words: list[str]) -> bool:
                or (w.endswith("ed") and is_placing(w[:-2])) for i, w in enumerate(words))
 
 
+def _shapes(words: list[str]) -> list[str]:
+    """The shapes ``words`` name, once each. "Corner" is a shape only right before an object's
+    name ("the corner sofa"); "in the corner" says where a thing stands."""
+    def names_object_at(i: int) -> bool:
+        span = _find_category(words[i:i + 2])[1]
+        return span is not None and span[0] == 0
+
+    return list(dict.fromkeys(_SHAPES[w] for i, w in enumerate(words)
+                              if w in _SHAPES and (w != "corner" or names_object_at(i + 1))))
+
+
 def relation_name(rel: str) -> str:
     """The relation a phrase says: "beside", "by", "close to" are "next to"; "on the left-hand side
     of", "to the left of" are "left of" (and right); "on" and "atop" are "on top of"; the others as
@@ -380,7 +391,7 @@ def _attributes_outside(q: ParsedQuery, head: str, activity: str) -> None:
         return
     words = (head[:k] + " " + head[k + len(activity):]).split()
     q.colors = _colors(words)
-    q.shapes = list(dict.fromkeys(_SHAPES[w] for w in words if w in _SHAPES))
+    q.shapes = _shapes(words)
     q.materials = materials_in(words)
     q.size_word, q.size_axis = _size_word(words)
 
@@ -518,7 +529,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     q.colors = _colors(words)
     if len(q.colors) > 1 and "terracotta" in q.colors:  # "a yellow terracotta pot": a material here
         q.colors.remove("terracotta")
-    q.shapes = list(dict.fromkeys(_SHAPES[w] for w in words if w in _SHAPES))
+    q.shapes = _shapes(words)
     if "l-shaped" in head or "l shaped" in head:
         q.shapes = list(dict.fromkeys([*q.shapes, "L-shaped"]))
     q.materials = materials_in(words)
