@@ -251,12 +251,11 @@ class SceneContext:
         A region whose cues name two types about equally (an open plan: a kitchen open to the
         living room) keeps the per-object distance-based scores."""
         from capnav.language.room_prior import best_room
-        from capnav.language.rooms import object_region, segment_rooms, walkable_domain
+        from capnav.language.rooms import object_region, room_regions
 
         assert self.occupancy is not None
         spec = self.occupancy.spec
-        labels = segment_rooms(walkable_domain(self.occupancy, self.lo, self.hi), spec,
-                               self.config.door_width, self.config.min_room_m2)
+        labels = room_regions(self.occupancy, self.lo, self.hi, self.config.door_width, self.config.min_room_m2)
         if labels.max() < 1:
             return  # one region or none: the walls say nothing about rooms
         self.region = np.array([object_region(labels, spec, lo, hi) for lo, hi in zip(self.lo, self.hi, strict=True)],

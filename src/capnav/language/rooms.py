@@ -4,12 +4,18 @@ A cue object (a stove, a bed) says "kitchen" or "bedroom" to the objects it can 
 few metres, not to those behind a wall. Distances are computed through free space and furniture
 (a sofa does not cut a room in two), never through walls: occupied cells that no object's box
 covers. The grid's one-cell unsampled gaps are closed first (``fill_gaps``).
+
+Rooms (``room_regions``) must not hang on one row of cells: a pocket of free space behind
+furniture whose only way out is a strip no frame saw (a component of the walkable domain of its
+own) takes the room it opens into through the unseen cells, and an object's room is voted only
+by cells joined to its own (``object_region``), never by the next room's beyond a wall.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import ndimage
 
 from capnav.core.grid import FREE, OCCUPIED, UNKNOWN, GridSpec, OccupancyGrid
 
@@ -56,6 +62,18 @@ def walkable_domain(occ: OccupancyGrid, boxes_lo: NDArray[np.float64], boxes_hi:
     return dom
 
 
+def unseen_cells(occ: OccupancyGrid) -> NDArray[np.bool_]:
+    """Cells no frame saw (after ``fill_gaps``): not walkable, but no wall either."""
+    return fill_gaps(occ.cells) == UNKNOWN
+
+
+def room_regions(occ: OccupancyGrid, boxes_lo: NDArray[np.float64], boxes_hi: NDArray[np.float64],
+                 door_width: float = 1.0, min_core_m2: float = 1.0) -> NDArray[np.int32]:
+    """``segment_rooms`` of the walkable domain, pockets reached through unseen cells included."""
+    return segment_rooms(walkable_domain(occ, boxes_lo, boxes_hi), occ.spec, door_width, min_core_m2,
+                         unseen=unseen_cells(occ))
+
+
 def box_seeds(domain: NDArray[np.bool_], spec: GridSpec, los: NDArray[np.floating], his: NDArray[np.floating]
               ) -> NDArray[np.int64]:
     """The walkable cells (K, 2) row, col of several boxes: where a walk from them starts."""
@@ -97,16 +115,19 @@ def box_min(field: NDArray[np.float64], spec: GridSpec, lo: NDArray[np.floating]
 
 
 def segment_rooms(domain: NDArray[np.bool_], spec: GridSpec, door_width: float = 1.0,
-                  min_core_m2: float = 1.0) -> NDArray[np.int32]:
+                  min_core_m2: float = 1.0, unseen: NDArray[np.bool_] | None = None) -> NDArray[np.int32]:
     """Rooms as regions of the walkable domain: label per cell (-1 outside the domain).
 
     Interior doors are narrower than ``door_width``: eroding the domain by half of it closes every
     doorway (and any leak through a box that pokes through a wall), so each room's interior is one
     connected core. Cores smaller than ``min_core_m2`` are dropped; every other domain cell then
     goes to the core it is walked to first (one geodesic per core), so a doorway, a corridor too
-    narrow for a core and the space under furniture belong to the room they open into."""
-    from scipy import ndimage
+    narrow for a core and the space under furniture belong to the room they open into.
 
+    ``unseen`` (cells no frame saw): domain cells no core reaches (a pocket behind a sofa whose
+    way out nobody saw) go to the labelled cells they are walked to first through the domain and
+    the unseen cells, never through a wall, so a pocket takes the room it opens into. Without
+    it they stay -1 and an object standing there is given whatever room lies across the wall."""
     from capnav.core.geodesic import grid_geodesic  # numba only when rooms are segmented
 
     r = int(np.ceil(0.5 * door_width / spec.resolution))
@@ -126,6 +147,18 @@ def segment_rooms(domain: NDArray[np.bool_], spec: GridSpec, door_width: float =
         labels[closer] = k
         best[closer] = d[closer]
         k += 1
+    pocket = domain & (labels < 0)
+    if unseen is not None and k > 0 and pocket.any():
+        through = domain | unseen
+        best = np.full(domain.shape, np.inf)
+        found = np.full(domain.shape, -1, dtype=np.int32)
+        for room in range(k):
+            rr, cc = np.nonzero(labels == room)
+            d = grid_geodesic(through, np.stack([rr, cc], axis=1).astype(np.int64), np.inf)
+            closer = pocket & (d < best)
+            found[closer] = room
+            best[closer] = d[closer]
+        labels[pocket] = found[pocket]
     return labels
 
 
@@ -149,5 +182,18 @@ def object_region(labels: NDArray[np.int32], spec: GridSpec, lo: NDArray[np.floa
     valid = patch >= 0
     if not valid.any():
         return -1
-    votes = np.bincount(patch[valid], weights=weights[valid])
+    # Only cells joined to the object's own (its inner half's, else its box's) through labelled
+    # cells of the ring vote: the next room's, beyond a wall (-1 cells), do not.
+    joined = valid
+    comp, _ = ndimage.label(valid)
+    for own in ((slice(b0, b1), slice(d0, d1)),
+                (slice(max(fr0 - r0, 0), max(fr1 - r0 + 1, 0)), slice(max(fc0 - c0, 0), max(fc1 - c0 + 1, 0)))):
+        ids = np.unique(comp[own])
+        ids = ids[ids > 0]
+        if len(ids):
+            mine = np.isin(comp, ids)
+            if (weights[mine] > 0).any():
+                joined = mine
+                break
+    votes = np.bincount(patch[joined], weights=weights[joined])
     return int(np.argmax(votes)) if votes.max() > 0 else -1

@@ -55,14 +55,14 @@ class MemoryConfig:
     ``pool_unconfirmed``: the buffered detections of a track that died before ``h_min`` hits are
     kept and count for a later track of the same thing (3D overlap as above, compatible label or
     descriptor), so ``h_min`` detections of one place make an object however far apart in time;
-    random false positives (random place and label) still never add up. Off by default for now:
-    it finds the small and glimpsed things (seed 100's cactus, the demo apartment's fifth
-    armchair, Yolo-Fastest recall 33 -> 40% on Sweet Home 3D seed 0 at 100% precision), but on the
-    demo apartment the map it makes puts a plant's room region in the office instead of the
-    living room ("the potted plant in the lounge" then fails): the plant stands in a pocket of
-    free space between a wall, a bookshelf and a sofa that one row of cells joins to its room
-    (``language.rooms.walkable_domain``), and with the other map's boxes that row is not in the
-    domain, so only the office's cells across the wall vote in ``object_region``."""
+    random false positives (random place and label) still never add up. On by default: it finds
+    the small and glimpsed things (seed 100's cactus, the demo apartment's fifth armchair,
+    Yolo-Fastest recall 33 -> 40% on Sweet Home 3D seed 0 at 100% precision). It was off while
+    the room regions hung on one row of cells: on the demo apartment a plant stands in a pocket of
+    free space between a wall, a bookshelf and a sofa whose way out, in the pooled map, is a
+    strip no frame saw, so the pocket was reached from no room and only the office's cells across
+    the wall voted in ``object_region``. Pockets now take the room they open into through unseen
+    cells (``language.rooms.room_regions``) and only cells joined to an object's own vote."""
 
     point_voxel: float = 0.03
     max_points: int = 3000
@@ -79,7 +79,7 @@ class MemoryConfig:
     recheck_inside: float = 0.2
     recheck_min_points: int = 50
     same_overlap: float = 0.95
-    pool_unconfirmed: bool = False
+    pool_unconfirmed: bool = True
     max_dormant: int = 512  # buffers of dead unconfirmed tracks kept (the oldest go first): bounded on long recordings
     seed: int = 0
 

@@ -29,12 +29,11 @@ _CACHE = "route/regions"
 
 def region_labels(scene: SceneContext) -> NDArray[np.int32] | None:
     """The room region of every grid cell (-1 outside the walkable space), as the scene types them."""
-    from capnav.language.rooms import segment_rooms, walkable_domain
+    from capnav.language.rooms import room_regions
 
     if scene.occupancy is None:
         return None
-    return segment_rooms(walkable_domain(scene.occupancy, scene.lo, scene.hi), scene.occupancy.spec,
-                         scene.config.door_width, scene.config.min_room_m2)
+    return room_regions(scene.occupancy, scene.lo, scene.hi, scene.config.door_width, scene.config.min_room_m2)
 
 
 def way_in(labels: NDArray[np.int32], to_region: int, from_regions: set[int]
