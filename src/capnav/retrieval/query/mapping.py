@@ -350,6 +350,12 @@ def _negations(q: ParsedQuery, head: str) -> str:
             q.negations.append(" ".join(words))
             continue
         cat, span, _ = _find_category(words)
+        before = _find_category(out[: m.start()].split())[0]
+        if cat is not None and before is not None and before != cat:
+            # "the sink, not the bathtub": another kind than the one asked for is excluded whole.
+            out = out[: m.start()] + " " + out[m.end():]
+            q.negations.append(" ".join(w for w in words if w not in _DETERMINERS))
+            continue
         if cat is not None and span is not None:
             out = out[: m.start()] + " " + " ".join(words[span[0]:span[1]]) + " " + out[m.end():]
             words = words[:span[0]] + words[span[1]:]
