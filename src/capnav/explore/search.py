@@ -173,6 +173,7 @@ class ObjectSearch:
         self._answered: dict[int, MapObject] = {}  # saved objects that were the answer at some time
         self._spots: list[tuple[float, float]] = []  # where the robot looked around
         self._cells_at: tuple[int, np.ndarray] | None = None  # the online map's cells, at a number of views
+        self._held: Answer | None = None  # a confirmed answer to a superlative that a saved object gone outranks
 
     # ------------------------------------------------------------------ the request
     def run(self, instruction: str | ParsedQuery, first: QueryResult | None = None) -> SearchResult:
@@ -214,7 +215,9 @@ class ObjectSearch:
         self._spots.append(ex.xy)  # looked around where the request was heard
         while not self._over(None):
             ans = self._ask(force=True)
-            if ans.kind in ("new", "confirmed") and ans.obj is not None:
+            if self._hold(ans):
+                ans = Answer("none", None, f"{ans.reason} (held back: {self._held_why})", ans.seen)
+            elif ans.kind in ("new", "confirmed") and ans.obj is not None:
                 res = self._approach(ans)
                 if res is not None:
                     return res
@@ -223,11 +226,18 @@ class ObjectSearch:
                 self._check_place(ans.obj)
                 continue
             cands, dist, level = self._choices(places, visited, regions)
+            utility = np.array([p.prior for p in cands]) / (1.0 + dist / cfg.distance_scale)
+            utility[~np.isfinite(dist)] = -1.0
+            if self._held is not None and (not cands or utility.max() < 0):
+                held, self._held = self._held, None
+                self._log("search", f"no place left to look for what outranks it; taking {held.reason}", ex.xy)
+                res = self._approach(held)
+                if res is not None:
+                    return res
+                continue
             if not cands:
                 return self._end(f"not found: every place worth looking was looked at ({len(visited)} places, "
                                  f"{ex.looks} views) and {self._none_text(ans)}")
-            utility = np.array([p.prior for p in cands]) / (1.0 + dist / cfg.distance_scale)
-            utility[~np.isfinite(dist)] = -1.0
             k = int(np.argmax(utility))
             if utility[k] < 0:
                 return self._end(f"not found: no place left to look from can be reached ({len(visited)} places "
@@ -257,6 +267,54 @@ class ObjectSearch:
                 self._spots.append(ex.xy)
                 ex.look_around(self._stop)
         return self._out_of_budget()
+
+    def _hold(self, ans: Answer) -> bool:
+        """Hold back a saved object confirmed at its place as the answer to a superlative ("the
+        biggest plant") while a saved object of its kind that outranks it was seen gone from its
+        place, or not at it: that one was carried somewhere, and is the answer wherever it stands
+        now. The search goes on for it (a bigger one seen is the retriever's answer), until no
+        place is left to look or half the budget is driven; then the held answer is taken.
+
+        Why: on seed 100 "the biggest houseplant" and "the largest plant" (twice) were answered by a
+        saved plant confirmed at its place, while the biggest, which the map had seen gone from its
+        old place, stood unseen in another room: a superlative is only as good as the part of the
+        home seen, and the map says which part of it a better candidate left."""
+        if self._held is not None and ans.kind == "confirmed" and ans.same(self._held):
+            if self.driven() < 0.5 * self.config.budget_m:
+                return True
+            self._log("search", f"half the budget driven; taking {ans.reason}", self.explorer.xy)
+            self._held = None
+            return False
+        rival = self._outranks(ans)
+        if rival is None:
+            return False
+        self._held = ans
+        what = rival.caption or rival.label
+        self._held_why = (f"object {rival.id} ({what}) would be {self._parsed.superlative}, and it was seen gone "
+                          f"from its place at ({rival.position[0]:.2f}, {rival.position[1]:.2f}): looking for it")
+        self._log("search", f"{ans.reason}; held back: {self._held_why}", _xy(rival))
+        return True
+
+    def _outranks(self, ans: Answer) -> MapObject | None:
+        """The saved object of the answer's kind, seen gone or not at its place, that a superlative
+        request would rank above a confirmed answer (by more than a tenth), if any."""
+        q, snap, o = self._parsed, self._snap, ans.obj
+        if q.superlative not in ("largest", "smallest") or ans.kind != "confirmed" or o is None or snap is None:
+            return None
+        if self._held is not None and ans.same(self._held):
+            return None
+
+        def measure(m: MapObject) -> float:
+            ext = np.asarray(m.extent_max, np.float64) - np.asarray(m.extent_min, np.float64)
+            return float(ext[2]) if q.size_axis == "height" else float(np.prod(np.maximum(ext, 1e-3)))
+
+        mine = measure(o)
+        gone = snap.gone | self.live.absent
+        rivals = [m for m in self.cmap.objects if m.id in gone and m.id != o.id and m.label == o.label
+                  and (measure(m) > 1.1 * mine if q.superlative == "largest" else measure(m) < mine / 1.1)]
+        if not rivals:
+            return None
+        return max(rivals, key=measure) if q.superlative == "largest" else min(rivals, key=measure)
 
     def _go(self, p: Place, lvl: Level) -> Status:
         """Drive to a place to look from (an object seen: to a step back from it)."""
@@ -501,6 +559,8 @@ class ObjectSearch:
             return True
         prev = self._answer
         ans = self._ask()
+        if self._held is not None and ans.kind == "confirmed" and ans.same(self._held):
+            return False  # still the answer held back (``_hold``): drive on to look for what outranks it
         return ans is not prev and (ans.kind in ("new", "confirmed") or not ans.same(prev))
 
     def _approach(self, ans: Answer) -> SearchResult | None:
