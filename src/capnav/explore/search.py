@@ -174,6 +174,7 @@ class ObjectSearch:
         self._spots: list[tuple[float, float]] = []  # where the robot looked around
         self._cells_at: tuple[int, np.ndarray] | None = None  # the online map's cells, at a number of views
         self._held: Answer | None = None  # a confirmed answer to a superlative that a saved object gone outranks
+        self._released: set[int] = set()  # answers held back once and then taken: never held again
 
     # ------------------------------------------------------------------ the request
     def run(self, instruction: str | ParsedQuery, first: QueryResult | None = None) -> SearchResult:
@@ -230,6 +231,8 @@ class ObjectSearch:
             utility[~np.isfinite(dist)] = -1.0
             if self._held is not None and (not cands or utility.max() < 0):
                 held, self._held = self._held, None
+                if held.obj is not None:
+                    self._released.add(held.obj.id)
                 self._log("search", f"no place left to look for what outranks it; taking {held.reason}", ex.xy)
                 res = self._approach(held)
                 if res is not None:
@@ -284,6 +287,8 @@ class ObjectSearch:
                 return True
             self._log("search", f"half the budget driven; taking {ans.reason}", self.explorer.xy)
             self._held = None
+            if ans.obj is not None:
+                self._released.add(ans.obj.id)
             return False
         rival = self._outranks(ans)
         if rival is None:
@@ -301,7 +306,7 @@ class ObjectSearch:
         q, snap, o = self._parsed, self._snap, ans.obj
         if q.superlative not in ("largest", "smallest") or ans.kind != "confirmed" or o is None or snap is None:
             return None
-        if self._held is not None and ans.same(self._held):
+        if (self._held is not None and ans.same(self._held)) or o.id in self._released:
             return None
 
         def measure(m: MapObject) -> float:
