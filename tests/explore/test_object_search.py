@@ -347,7 +347,7 @@ def test_the_biggest_plant_carried_off_is_looked_for_before_a_smaller_one_is_tak
     """The first map holds a big plant and a small one in room A; the big one was carried into room
     B. From the start the robot sees the big one's place empty and the small one at its place:
     "the biggest plant" is not the small one (confirmed at its place, and it was the answer with
-    the search of f43537b) while the bigger one the map saw gone may stand elsewhere; the search
+    the search of 5a9081c) while the bigger one the map saw gone may stand elsewhere; the search
     looks on, finds it in room B and goes there."""
     small = Box((0.0, -2.3, 0.0), (0.3, -2.0, 0.45), 20, PLANT, (40, 140, 50))
     big_at = ((-1.9, 0.3), (-1.3, 0.9))
