@@ -226,7 +226,7 @@ class ObjectSearch:
             if ans.kind == "saved" and ans.obj is not None:
                 self._check_place(ans.obj)
                 continue
-            cands, dist, level = self._choices(places, visited, regions)
+            cands, dist, levels = self._choices(places, visited, regions)
             utility = np.array([p.prior for p in cands]) / (1.0 + dist / cfg.distance_scale)
             utility[~np.isfinite(dist)] = -1.0
             if self._held is not None and (not cands or utility.max() < 0):
@@ -245,9 +245,11 @@ class ObjectSearch:
             if utility[k] < 0:
                 return self._end(f"not found: no place left to look from can be reached ({len(visited)} places "
                                  f"looked from, {ex.looks} views, also with {self._levels[-1].describe()})")
+            level = int(levels[k])
             lvl = self._levels[level]
             if level > 0:
-                self._log("search", f"nothing to look from is reachable with {self._levels[0].describe()} (a gap "
+                self._log("search", f"({cands[k].xy[0]:.2f}, {cands[k].xy[1]:.2f}) is not reachable with "
+                                    f"{self._levels[0].describe()} (a gap "
                                     f"narrower than the robot and its margin, or closed by a contact mark); "
                                     f"planning with {lvl.describe()}", ex.xy)
             p = cands[k]
@@ -371,31 +373,46 @@ class ObjectSearch:
         return False
 
     def _choices(self, places: Sequence[Place], visited: Sequence[tuple[float, float]],
-                 regions: np.ndarray) -> tuple[list[Place], np.ndarray, int]:
-        """Places worth looking from, their path lengths, and the level planned with: the strictest
-        of ``levels.search_levels`` from which any of them can be reached (a relaxed level may also
-        open frontiers beyond a narrow gap)."""
+                 regions: np.ndarray) -> tuple[list[Place], np.ndarray, np.ndarray]:
+        """Places worth looking from, their path lengths, and for each the level to plan with: the
+        strictest of ``levels.search_levels`` at which it can be reached (a relaxed level may also
+        open frontiers beyond a narrow gap: those a stricter level does not have).
+
+        Why per place: with one level for all (the strictest that reached any place), the kitchen
+        whose door only the bare radius fits through was never weighed while any place in the
+        first rooms was reachable with the margin, and the search looked in every other room first
+        (s100002-added-0, -2: "the chair that is oak" reached at 24-28 m against a 17-20 m limit)."""
         cfg, ex = self.config, self.explorer
-        first: tuple[list[Place], np.ndarray, int] | None = None
+        out: list[Place] = []
+        dist: list[float] = []
+        lv: list[int] = []
+        fixed = [p for p in places if not self._spent(p, visited, regions)] + self._second_looks(visited)
+        todo = list(range(len(fixed)))
         for level, lvl in enumerate(self._levels):
             ex.forgive_contacts = lvl.forgive_contacts
             grid = ex.grid()
             ex.forgive_contacts = False
             cm = ex.costmap(grid, lvl.planner)
-            cands = [p for p in places if not self._spent(p, visited, regions)]
-            fronts = ex.frontiers(grid, cm)
-            cands += [Place(f.target_xy, -1, cfg.frontier_prior * min(1.0, f.size / cfg.frontier_cells),
+            fronts = [Place(f.target_xy, -1, cfg.frontier_prior * min(1.0, f.size / cfg.frontier_cells),
                             f"a frontier of unseen space ({f.size} cells)")
-                      for f in fronts if all(math.dist(f.target_xy, v) > ex.config.visited_radius for v in visited)]
-            cands += self._second_looks(visited)
+                      for f in ex.frontiers(grid, cm)
+                      if all(math.dist(f.target_xy, v) > ex.config.visited_radius for v in visited)
+                      and all(math.dist(f.target_xy, q.xy) > ex.config.visited_radius
+                              for q, lq in zip(out, lv, strict=True) if q.region == -1 and lq < level)]
+            cands = [fixed[i] for i in todo] + fronts
             reach = [cfg.second_look_m if p.region == SECOND_LOOK else cfg.place_reach for p in cands]
-            dist = path_lengths(grid, cm, ex.xy, [p.xy for p in cands], lvl.planner, reach) if cands else np.zeros(0)
-            if np.isfinite(dist).any():
-                return cands, dist, level
-            if first is None or (cands and not first[0]):
-                first = (cands, dist, level)
-        assert first is not None
-        return first
+            d = path_lengths(grid, cm, ex.xy, [p.xy for p in cands], lvl.planner, reach) if cands else np.zeros(0)
+            last = level == len(self._levels) - 1
+            left = []
+            for j, p in enumerate(cands):
+                if np.isfinite(d[j]) or (last and j < len(todo)):
+                    out.append(p)
+                    dist.append(float(d[j]))
+                    lv.append(level)
+                elif j < len(todo):
+                    left.append(todo[j])
+            todo = left
+        return out, np.asarray(dist, np.float64), np.asarray(lv, np.int64)
 
     def _second_looks(self, visited: Sequence[tuple[float, float]]) -> list[Place]:
         """Objects of the requested kind the robot saw that the retriever did not take: a first
