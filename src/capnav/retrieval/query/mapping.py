@@ -19,6 +19,7 @@ from capnav.retrieval.query.count import read_count, without
 from capnav.retrieval.query.model import ACROSS, BETWEEN, ROOM_WITH, ParsedQuery
 from capnav.retrieval.query.parse import _GENERIC, GoalParse, describe
 from capnav.retrieval.query.tokens import (
+    _COLOUR_OF,
     _COMMON_ADJECTIVES,
     _FILLER,
     _GROWTH,
@@ -31,6 +32,7 @@ from capnav.retrieval.query.tokens import (
     _SHAPES,
     _SIZE_TOKENS,
     _SUPERLATIVE,
+    UNOBSERVED,
     _colors,
     _find_category,
     _fix_keyword_typos,
@@ -38,6 +40,7 @@ from capnav.retrieval.query.tokens import (
     _other_object,
     _room_before,
     _size_word,
+    material_of,
     materials_in,
     size_axis,
     validate_instruction,
@@ -513,7 +516,11 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     known = (set(_FILLER) | set(LEXICON) | set(ALIASES) | set(_SHAPES) | _SIZE_TOKENS | set(_SUPERLATIVE)
              | set(_MATERIAL_OF) | _COMMON_ADJECTIVES | {w for c in q.colors for w in c.split()}
              | (_GROWTH_TOKENS if cat == "plant" else set())
-             | {w for w in words if re.fullmatch(r"[a-z]+-colou?red", w)})
+             | {w for w in words if re.fullmatch(r"[a-z]+-colou?red", w) or material_of(w)}
+             | set(UNOBSERVED) | {w for w in words if w in _COLOUR_OF and _COLOUR_OF[w] in q.colors})
+    for w in dict.fromkeys(w for w in words if w in UNOBSERVED):
+        # "the squishy armchair": WordNet's soft; no map observes it, so it neither confirms nor refuses.
+        q.notes.append(f"'{w}' says {UNOBSERVED[w]}, which the map does not observe")
     if cat is not None and span is not None:
         form = " ".join(words[span[0]:span[1]])
         q.category_alternatives = _LEX.category_alternatives(cat, None if fuzzy else form)
