@@ -127,3 +127,19 @@ def test_softness_words_are_known_but_unobserved():
         q = parse_instruction(text)
         assert not q.unknown_words, q.to_dict()
         assert any("soft" in n for n in q.notes), q.notes
+
+
+@pytest.mark.parametrize("text", ["the stool that isn't wooden", "take me to the stool not made of wood",
+                                  "the non-wooden stool", "the stool which is not made out of timber",
+                                  "find me a stool that's not wood"])
+def test_a_negated_material_excludes_the_stool_that_shows_it(emb, text):
+    res = retriever(emb, {3, 4}).query(text)
+    assert res.found and res.chosen.id == 4, res.reason
+
+
+def test_a_negated_material_no_pixels_show_neither_excludes_nor_refuses(emb):
+    # Metal shows nothing in pixels: "not metal" cannot tell the stools apart, and refuses neither.
+    res = retriever(emb, {3, 4}).query("the stool that isn't made of metal")
+    assert res.found, res.reason
+    q = parse_instruction("the non-leather armchair")
+    assert q.negations and "leather" in q.negations[0] and not q.unknown_words, q.to_dict()

@@ -40,6 +40,7 @@ from capnav.retrieval.query.tokens import (
     _other_object,
     _room_before,
     _size_word,
+    attribute_word,
     material_of,
     materials_in,
     size_axis,
@@ -53,6 +54,8 @@ if TYPE_CHECKING:
 _NEGATION = re.compile(r"(?:\b(?:that|which|who)\s+)?(?:\bis\s+not\b|\bisn't\b|\bisnt\b|\bnot\b|\bother\s+than\b"
                        r"|\bexcept(?:\s+for)?\b|\bapart\s+from\b|\brather\s+than\b|\binstead\s+of\b)"
                        r"\s+(?P<neg>[^,;]+?)(?=\s*(?:[,;]|\bbut\b|\bthe\s+other\b|$))")
+#: "non-leather", "non wooden": the prefix negates an attribute word.
+_NON = re.compile(r"\bnon\s*-?\s*([a-z]+(?:-[a-z]+)?)\b")
 #: The robot itself as the reference of closest / farthest.
 _SELF = re.compile(r"^(?:me|you|us|here|yourself|the robot|where i am|where you are|my position|"
                    r"your position)\b")
@@ -406,8 +409,14 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     norm = re.sub(r"[^a-z0-9\-' ]+", " ", low)
     norm = re.sub(r"\b(\w+)n't\b", r"\1 not", norm.replace("isn't", "is not").replace("isnt", "is not"))
     norm = " ".join(_fix_keyword_typos(norm.replace("'s", "").split()))
+    # "the non-leather sofa": the prefix negates that attribute word alone (not the clause after it).
+    non = [x for x in _NON.finditer(norm) if attribute_word(x.group(1))]
+    for x in non[::-1]:
+        norm = norm[: x.start()] + norm[x.end():]
+    norm = " ".join(norm.split())
     q = ParsedQuery(text=t)
     head = _negations(q, norm)
+    q.negations += [x.group(1) for x in non]
     # "somewhere to rest my plate while we watch the tv": the tv is where, not what.
     head = _purpose_context(q, head)
     # "somewhere right by the bed to put my glass": the landmark of the place asked for.

@@ -296,7 +296,7 @@ def _find_vocabulary(words: list[str]) -> tuple[str | None, tuple[int, int] | No
     for i, w in enumerate(words):
         if len(w) < 4 or w in _FILLER or canonical_color(w) or w in _SHAPES or w in _SIZE_WORDS \
                 or w in _LEX.not_typos or w in LABEL_MAP or w in _FORM_MAP or not w.isalpha() \
-                or w in _COMMON_ADJECTIVES or w in _ENGLISH_HINTS:
+                or w in _COMMON_ADJECTIVES or w in _ENGLISH_HINTS or w in _LEX.attributes:
             continue
         near = _nearest(w, _SINGLE_BY_LETTER.get(w[0], []))
         # A word two or more letters short of a name's start is another word, not a typo ("wash").
@@ -375,7 +375,7 @@ def _fix_keyword_typos(words: list[str]) -> list[str]:
     out = []
     for w in words:
         if w in _ENGLISH_HINTS or w in _FORM_WORDS or w in _LEX.not_typos or w in _COMMON_ADJECTIVES \
-                or not w.isalpha() or len(w) < 3:
+                or w in _LEX.attributes or not w.isalpha() or len(w) < 3:
             out.append(w)
             continue
         fixed = None
