@@ -97,6 +97,12 @@ is spoken to):
   rather than for what the cup is kept in; ``body``: nouns for parts of the body (noun.body) with
   their plurals, so that "somewhere to rest my feet" rests the person.
 
+- ``attributes``: adjectives (and a few nouns) the tables above lack, mapped onto an attribute
+  the map reads through WordNet's relations, each with its kind, value and relation ("boxy":
+  shape rectangular by its gloss; "oblong": long by similar_to; "see-through": glass by the
+  material's definition; "timber": wood by its genus; "vermilion": scarlet by hypernym;
+  "squishy": soft, a property no map observes, read and never judged): ``_attributes`` says how.
+
 WordNet's licence notice is copied beside the data (``WORDNET_LICENSE``).
 """
 
