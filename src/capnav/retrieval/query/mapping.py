@@ -291,6 +291,25 @@ def _put_down(words: list[str]) -> bool:
                or (w.endswith("ed") and is_placing(w[:-2])) for i, w in enumerate(words))
 
 
+_PAST = re.compile(r"\b(?:past|via)\s+" + _ARTICLE)
+
+
+def _passed_objects(q: ParsedQuery, head: str) -> str:
+    """An object walked past before any object is named ("go past the sofa and stop at the
+    bookshelf") is passed, not the goal, when another object is named after it: its phrase is
+    taken out, with a note. "The lamp past the sofa" names its target first and keeps the phrase."""
+    for m in list(_PAST.finditer(head))[::-1]:
+        before, after = head[:m.start()].split(), head[m.end():].split()
+        cat, span, _ = _find_category(after)
+        if cat is None or span is None or span[0] != 0 or _find_category(before)[0] is not None:
+            continue
+        if _find_category(after[span[1]:])[0] is None:
+            continue
+        q.notes.append(f"the {' '.join(after[:span[1]])} is passed on the way, not the goal")
+        head = " ".join([*before, *after[span[1]:]])
+    return head
+
+
 def _shapes(words: list[str]) -> list[str]:
     """The shapes ``words`` name, once each. "Corner" is a shape only right before an object's
     name ("the corner sofa"); "in the corner" says where a thing stands."""
@@ -451,6 +470,8 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     head = " ".join(re.sub(r"[,;]", " ", _negations(q, norm)).split())
     norm = " ".join(re.sub(r"[,;]", " ", norm).split())
     q.negations += [x.group(1) for x in non]
+    # "go past the sofa and stop at the bookshelf": the sofa is passed on the way.
+    head = _passed_objects(q, head)
     # "somewhere to rest my plate while we watch the tv": the tv is where, not what.
     head = _purpose_context(q, head)
     # "somewhere right by the bed to put my glass": the landmark of the place asked for.
