@@ -28,7 +28,7 @@ import numpy as np
 from capnav.core.errors import CapNavError
 from capnav.core.registry import Registry
 from capnav.language.captioner import RetryPolicy
-from capnav.language.colors import ColorCluster, color_agreement, family
+from capnav.language.colors import LIGHT_SHADE_SHARE, ColorCluster, family, lighter_shade, term_agreement
 from capnav.language.context import SceneContext, canonical_label
 from capnav.language.embedder import TextEmbedder
 from capnav.language.form import shape_conflict
@@ -302,9 +302,11 @@ class OfflineVerifier(Verifier):
         for word in words:
             shades = family(word)
             # (agreement, shade index, cluster) of every observed colour cluster against every shade.
-            vals = [(color_agreement(w, c.lab) * (floor + (1.0 - floor) * min(1.0, c.fraction / 0.5)), k, j)
+            vals = [(term_agreement(w, c.lab) * (floor + (1.0 - floor) * min(1.0, c.fraction / 0.5)), k, j)
                     for j, c in enumerate(cols) for k, w in enumerate(shades)]
-            rank, _, j = max((v * (1.0 if k == 0 else self.config.shade_weight), k, j) for v, k, j in vals)
+            share = [1.0] + [self.config.shade_weight * (LIGHT_SHADE_SHARE if lighter_shade(word, w) else 1.0)
+                             for w in shades[1:]]
+            rank, _, j = max((v * share[k], k, j) for v, k, j in vals)
             fit, k, jf = max(vals)
             ranks.append(rank)
             fits.append(fit)
