@@ -113,3 +113,18 @@ def test_a_dark_shade_of_another_word_is_still_refused(label: str, rgb: tuple[in
 def test_lightness_modifier_moves_the_word() -> None:
     light, plain = color_lab("light blue"), color_lab("blue")
     assert light is not None and plain is not None and light[0] > plain[0]
+
+
+def test_shade_ray_stays_within_the_word() -> None:
+    from capnav.core.colour import srgb_to_lab
+    from capnav.language.colors import color_agreement, shade_ray, term_agreement
+
+    assert len(shade_ray("white")) == len(shade_ray("grey")) == len(shade_ray("black")) == 1  # no hue
+    assert len(shade_ray("light blue")) == len(shade_ray("navy")) == 1  # a said shade is its own point
+    assert len(shade_ray("blue")) > 1
+    navy = srgb_to_lab(np.array([40.0, 50.0, 120.0]))
+    assert term_agreement("blue", navy) > color_agreement("blue", navy) + 0.15
+    brown = srgb_to_lab(np.array([95.0, 55.0, 30.0]))  # brown is no dark orange
+    assert term_agreement("orange", brown) < 0.3
+    light = srgb_to_lab(np.array([150.0, 180.0, 220.0]))  # lighter than blue: not on the ray
+    assert term_agreement("blue", light) == pytest.approx(color_agreement("blue", light))
