@@ -97,6 +97,12 @@ is spoken to):
   rather than for what the cup is kept in; ``body``: nouns for parts of the body (noun.body) with
   their plurals, so that "somewhere to rest my feet" rests the person.
 
+- ``attributes``: adjectives (and a few nouns) the tables above lack, mapped onto an attribute
+  the map reads through WordNet's relations, each with its kind, value and relation ("boxy":
+  shape rectangular by its gloss; "oblong": long by similar_to; "see-through": glass by the
+  material's definition; "timber": wood by its genus; "vermilion": scarlet by hypernym;
+  "squishy": soft, a property no map observes, read and never judged): ``_attributes`` says how.
+
 WordNet's licence notice is copied beside the data (``WORDNET_LICENSE``).
 """
 
@@ -208,6 +214,7 @@ def build(wordnet: Path) -> dict[str, Any]:
         out["body"] = _body(wn, noun_exc)
         out["materials"] = _materials(wn, out["forms"], out["labels"])
         out["rooms"] = _rooms(wn, out["forms"], noun_exc)
+        out["attributes"] = _attributes(wn, out)
         out["forms"] = dict(sorted(out["forms"].items()))
         return out
 
@@ -529,6 +536,239 @@ def _materials(wn: Any, forms: dict[str, str], labels: dict[str, str]) -> dict[s
         if m is not None:
             out[w] = m
     return out
+
+
+#: The shape words the parse reads (``capnav.retrieval.query.tokens._SHAPES``, judged by
+#: ``capnav.language.form``) and the WordNet adjective each one is.
+SHAPE_HEADS = {"round": "round.a.01", "long": "long.a.02", "square": "square.a.01",
+               "rectangular": "rectangular.s.01", "curved": "curved.a.01", "L-shaped": "l-shaped.s.01"}
+#: Properties no map observes, each with its WordNet adjective: a word of them is read and
+#: neither confirms nor refuses ("squishy", "padded", "cushioned": soft.a.01's cluster).
+UNOBSERVED_HEADS = {"soft": "soft.a.01"}
+#: The colour nouns: every hyponym of ``color.n.01`` (noun.attribute).
+COLOUR_ROOT = "color.n.01"
+#: Colour adjectives: the satellites of the adjectives of hue (chromatic, achromatic).
+COLOUR_ADJECTIVE_HEADS = ["chromatic.a.03", "achromatic.a.01"]
+
+
+def _attributes(wn: Any, lex: dict[str, Any]) -> dict[str, list[str]]:
+    """Adjectives (and a few nouns) the plain tables lack, mapped onto the attributes the map
+    reads through WordNet's relations: word -> [kind, value, relation]. Kinds: "shape" (a word of
+    ``SHAPE_HEADS``), "material" (a material of ``MATERIAL_ROOTS``), "colour" (a colour phrase
+    ``capnav.language.colors.color_lab`` knows) and "unobserved" (``UNOBSERVED_HEADS``: read,
+    never judged). Relations, the first that gives a value wins:
+
+    - ``similar_to``: the lemma lies in the head adjective's cluster (its similar-tos) and its most
+      frequent adjective sense is there ("spherical", "disc-shaped": round; "oblong": long;
+      "squishy", "padded": soft);
+    - ``also_see``: the lemma of an adjective the head points to ("rounded": round);
+    - ``gloss``: an adjective whose definition names the head's attribute noun ("boxy":
+      "resembling a box in rectangularity", rectangularity being rectangular's noun);
+    - ``definition``: a descriptive adjective (one with an attribute noun in WordNet, directly or
+      through its cluster's head) said before the genus of one material's own definition and of no
+      other's (glass.n.01: "a brittle transparent solid": transparent, and the lemmas of its first
+      two senses whose first sense they are, "see-through"); soft, said of cotton, is taken by the
+      unobserved kind first;
+    - ``genus``: a noun whose definition's genus is a material ("timber": "the wood of trees cut
+      and prepared for use as building material");
+    - ``hypernym``: a colour noun's nearest colour up the tree ("vermilion": scarlet; "azure":
+      blue; not the lightness its definition may give: azure's noun is "a light shade of blue",
+      its adjective "a deep somewhat purplish blue", so the broader word refuses less);
+    - ``derivation``: a colour adjective derived from a colour noun, or in a synset with a colour
+      word ("ruby": red; "sapphire": blue);
+    - ``gloss``: a colour adjective whose definition names a colour ("tangerine": "of a strong
+      reddish orange color").
+
+    A word must be a lower-case WordNet lemma whose most frequent sense of its part of speech is the
+    one related (and not used more often as a verb or a noun, for adjectives), and no word any other
+    table holds (categories, detector classes, colours, materials, rooms, sizes, heights, growth);
+    a colour word also names no material ("cherry" is a wood)."""
+    import re
+
+    from capnav.language.colors import SHADES, canonical_color, color_lab
+
+    taken = (set(lex["forms"]) | set(lex["labels"]) | set(lex["materials"]) | set(lex["rooms"]) | set(lex["sizes"])
+             | set(lex["heights"]) | set(lex["height_superlatives"]) | set(lex["growth"]) | set(lex["kinds"])
+             | set(LEXICON) | set(ALIASES) | set(SHADES) | ROOM_WORDS)
+    material_synsets = {n: m for m, names in MATERIAL_ROOTS.items() for n in names}
+    stop = _english_stop_words()
+
+    def count(lemma: str, pos: str) -> int:
+        return sum(lem.count() for s in wn.synsets(lemma, pos) for lem in s.lemmas() if lem.name() == lemma)
+
+    def adjective_senses(lemma: str) -> list[Any]:
+        return [s for s in wn.synsets(lemma) if s.pos() in "as" and any(x.name() == lemma for x in s.lemmas())]
+
+    def usable(lemma: str) -> bool:
+        return (lemma == lemma.lower() and "_" not in lemma and all(ch.isalpha() or ch == "-" for ch in lemma)
+                and _form(lemma) not in taken)
+
+    def adjective(lemma: str, among: set[Any], senses: int = 1, first: bool = True) -> bool:
+        """One of the lemma's ``senses`` most frequent adjective senses is in ``among`` and (with
+        ``first``) it is an adjective first in the sense-tagged corpus."""
+        found = adjective_senses(lemma)
+        return (any(x in among for x in found[:senses])
+                and (not first or max(count(lemma, "n"), count(lemma, "v")) <= count(lemma, "a") + count(lemma, "s")))
+
+    def shape_first(lemma: str) -> bool:
+        """The lemma's first adjective sense is defined by a shape ("oblong": "(of a leaf shape)
+        having a somewhat elongated form"), so its second may be read ("far" is a distance first)."""
+        found = adjective_senses(lemma)
+        return bool(found) and re.search(r"\b(?:shape|form)\b", found[0].definition()) is not None
+
+    def names_material(word: str) -> bool:
+        for s in wn.synsets(word, "n"):
+            for path in s.hypernym_paths():
+                if any(x.name() in material_synsets for x in path):
+                    return True
+        return False
+
+    out: dict[str, list[str]] = {}
+
+    def add(lemma: str, kind: str, value: str, via: str) -> None:
+        if usable(lemma) and _form(lemma) not in out:
+            out[_form(lemma)] = [kind, value, via]
+            if "-" in lemma and _form(lemma).replace("-", " ") not in taken:
+                out.setdefault(_form(lemma).replace("-", " "), [kind, value, via])
+
+    heads = [("shape", v, wn.synset(n)) for v, n in SHAPE_HEADS.items()]
+    heads += [("unobserved", v, wn.synset(n)) for v, n in UNOBSERVED_HEADS.items()]
+    # similar_to: the head's cluster (a satellite head is a cluster of its own lemmas). A shape
+    # word's first two senses are read ("oblong": a leaf's shape first, elongated second).
+    for kind, value, head in heads:
+        cluster = {head, *head.similar_tos()} if head.pos() == "a" else {head}
+        for lemma in sorted({x.name() for s in cluster for x in s.lemmas()}):
+            if adjective(lemma, cluster) or (kind == "shape" and shape_first(lemma) and adjective(lemma, cluster, 2)):
+                add(lemma, kind, value, "similar_to")
+    # also_see: the lemmas of the adjectives the head points to.
+    for kind, value, head in heads:
+        for other in head.also_sees():
+            for lemma in sorted(x.name() for x in other.lemmas()):
+                if adjective(lemma, {other}):
+                    add(lemma, kind, value, "also_see")
+    # gloss: an adjective whose definition names the noun of a head's lemma ("rectangularity").
+    nouns: dict[str, tuple[str, str]] = {}
+    for kind, value, head in heads:
+        for lem in head.lemmas():
+            for d in lem.derivationally_related_forms():
+                if d.synset().pos() == "n" and d.synset().lexname() == "noun.attribute":
+                    nouns.setdefault(d.name().lower(), (kind, value))
+    for s in sorted(wn.all_synsets("a"), key=lambda x: x.name()):
+        hit = next((nouns[t] for t in re.findall(r"[a-z]+", s.definition().lower()) if t in nouns), None)
+        if hit is not None:
+            for lem in s.lemmas():
+                if adjective(lem.name(), {s}):
+                    add(lem.name(), hit[0], hit[1], "gloss")
+    # definition: descriptive adjectives before the genus of one material's own definition.
+    def descriptive(s: Any) -> bool:
+        return bool(s.attributes() or any(h.attributes() for h in s.similar_tos()))
+
+    def said_as_adjective(tok: str) -> bool:
+        return bool(adjective_senses(tok)) and count(tok, "n") <= count(tok, "a") + count(tok, "s")
+
+    said: dict[str, set[str]] = {}
+    for material, names in MATERIAL_ROOTS.items():
+        for n in names:
+            run: list[str] = []
+            for tok in re.findall(r"[a-z-]+", wn.synset(n).definition().lower()):
+                if tok in ("a", "an", "the") and not run:
+                    continue
+                if tok in stop or not said_as_adjective(tok):
+                    break  # the genus (or any noun or function word) ends the adjectives before it
+                run.append(tok)
+            if run and wn.synsets(run[-1], "n"):
+                run.pop()  # "a brittle transparent solid": the last one is the genus
+            for tok in run:
+                said.setdefault(tok, set()).add(material)
+    for word, materials in sorted(said.items()):
+        if len(materials) != 1:
+            continue
+        senses = [s for s in adjective_senses(word)[:MATERIAL_SENSES] if descriptive(s)]
+        for s in senses:
+            for lem in s.lemmas():
+                if adjective(lem.name(), set(senses)):
+                    add(lem.name(), "material", next(iter(materials)), "definition")
+    # genus: nouns defined as a kind of a material ("the wood of trees ...").
+    # The material's own words: lemmas of a root whose first noun sense it is ("cloth", not
+    # "material"); the genus is such a word followed by no other noun ("metal supports" are things).
+    material_words = {_form(x.name()): m for m, names in MATERIAL_ROOTS.items() for n in names
+                      for x in wn.synset(n).lemmas() if wn.synsets(x.name(), "n")[0] == wn.synset(n)}
+    for s in sorted(wn.all_synsets("n"), key=lambda x: x.name()):
+        if s.lexname() != "noun.substance":
+            continue
+        genus = None
+        toks = re.findall(r"[a-z-]+", s.definition().lower())
+        for k, tok in enumerate(toks):
+            if tok in ("a", "an", "the") and k == 0:
+                continue
+            if tok in material_words:
+                nxt = toks[k + 1] if k + 1 < len(toks) else None
+                if nxt is None or nxt in stop or said_as_adjective(nxt):
+                    genus = material_words[tok]
+            elif said_as_adjective(tok) and tok not in stop:
+                continue
+            break
+        if genus is None:
+            continue
+        for lem in s.lemmas():
+            senses = wn.synsets(lem.name(), "n")
+            if senses and senses[0] == s and count(lem.name(), "v") <= count(lem.name(), "n"):
+                add(lem.name(), "material", genus, "genus")
+    # hypernym: colour nouns.
+    named = set(LEXICON) | set(ALIASES) | set(SHADES)
+
+    def known_colour(s: Any) -> str | None:
+        """A colour word of the synset: a palette, alias or shade word first, else a phrase
+        ``color_lab`` reads ("reddish orange")."""
+        forms = [_form(lem.name()) for lem in s.lemmas() if lem.name() == lem.name().lower()]
+        for form in [*(f for f in forms if f in named), *(f for f in forms if f not in named)]:
+            if color_lab(form) is not None:
+                return canonical_color(form) or form
+        return None
+
+    colour_adjectives = {x for name in COLOUR_ADJECTIVE_HEADS for x in wn.synset(name).similar_tos()}
+
+    def colour_of(s: Any) -> str | None:
+        frontier: list[Any] = [s]
+        while frontier:
+            for x in frontier:
+                c = known_colour(x)
+                if c is not None:
+                    return c
+            frontier = [h for x in frontier for h in x.hypernyms()]
+        return None
+
+    colour_nouns = {s: c for s in wn.synset(COLOUR_ROOT).closure(lambda x: x.hyponyms())
+                    if (c := colour_of(s)) is not None}
+    for s, c in sorted(colour_nouns.items(), key=lambda kv: kv[0].name()):
+        for lem in s.lemmas():
+            senses = wn.synsets(lem.name(), "n")
+            adj = adjective_senses(lem.name())
+            if senses and senses[0] == s and not names_material(lem.name()) \
+                    and count(lem.name(), "v") <= count(lem.name(), "n") and (not adj or adj[0] in colour_adjectives):
+                add(lem.name(), "colour", c, "hypernym")
+    # derivation: colour adjectives (satellites of chromatic / achromatic).
+    for name in COLOUR_ADJECTIVE_HEADS:
+        for s in sorted(wn.synset(name).similar_tos(), key=lambda x: x.name()):
+            value = known_colour(s)
+            if value is None:
+                value = next((colour_nouns[d.synset()] for lem in s.lemmas()
+                              for d in lem.derivationally_related_forms() if d.synset() in colour_nouns), None)
+            via = "derivation"
+            if value is None:  # "of a strong reddish orange color": the colour its definition names
+                words = re.findall(r"[a-z-]+", s.definition().lower())
+                grams = [" ".join(words[i:i + n]) for n in (2, 1) for i in range(len(words) - n + 1)]
+                value = next((canonical_color(g) or g for g in grams
+                              if g.split()[-1] in named and color_lab(g) is not None), None)
+                via = "gloss"
+            if value is None:
+                continue
+            for lem in s.lemmas():
+                # Named after a thing ("tangerine", "chocolate"): a noun more often, a colour before
+                # a noun; its first adjective sense says so.
+                if adjective(lem.name(), {s}, first=False) and not names_material(lem.name()):
+                    add(lem.name(), "colour", value, via)
+    return dict(sorted(out.items()))
 
 
 #: CapNav's room types (``capnav.language.context``) and the WordNet synsets each one is; a name

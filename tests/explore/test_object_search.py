@@ -341,3 +341,59 @@ def test_a_look_from_behind_a_wall_does_not_spend_a_place(first_map: CapNavMap) 
     assert not s._spent(place, [(-1.0, -1.5)], regions)
     s._spots.append((-1.0, -1.4))  # looked around in room A, 1.1 m away, in the open
     assert s._spent(place, [], regions)
+
+
+def test_the_biggest_plant_carried_off_is_looked_for_before_a_smaller_one_is_taken() -> None:
+    """The first map holds a big plant and a small one in room A; the big one was carried into room
+    B. From the start the robot sees the big one's place empty and the small one at its place:
+    "the biggest plant" is not the small one (confirmed at its place, and it was the answer with
+    the search of 5a9081c) while the bigger one the map saw gone may stand elsewhere; the search
+    looks on, finds it in room B and goes there."""
+    small = Box((0.0, -2.3, 0.0), (0.3, -2.0, 0.45), 20, PLANT, (40, 140, 50))
+    big_at = ((-1.9, 0.3), (-1.3, 0.9))
+    big = Box((*big_at[0], 0.0), (*big_at[1], 1.4), 21, PLANT, (40, 140, 50))
+    mapped = [*_room_a((-0.3, 2.0)), small, big]
+    frames = [render(mapped, look_at_pose(np.array([*eye, 1.2]), float(yaw), math.radians(25)), K, index=2 * i + j)
+              for i, yaw in enumerate(np.radians(np.linspace(55, 305, 24)))
+              for j, eye in enumerate(((-1.2, 0.0), (-1.8, 0.4)))]
+    cmap = _captioned(build_map(frames, detector=create_detector("sim", noise="oracle", seed=0),
+                                encoder=create_encoder("label-embedding", embedder=HashEmbedder()), progress=False))
+    assert sorted(o.label for o in cmap.objects).count("plant") == 2
+    moved = Box((1.7, 1.5, 0.0), (2.3, 2.1, 1.4), 21, PLANT, (40, 140, 50))
+    world = [*_room_a((-0.3, 2.0)), small, moved]
+    agent, res = _search(cmap, world, "the biggest plant")
+    assert res.found, res.reason
+    assert _gap(agent, moved) <= 1.0 and _gap(agent, small) > 1.0, (agent.pose, res.reason)
+    assert any("held back" in s.reason for s in res.steps), [s.reason for s in res.steps]
+
+
+def test_a_place_beyond_a_narrow_door_is_weighed_with_the_rest(first_map: CapNavMap) -> None:
+    """A 0.52 m door (the robot fits, its margin does not) and a place to look from in room A that
+    the margin reaches: the unseen space beyond the door is still a candidate, weighed at the
+    inflation that reaches it (the search of 1dc02c1 weighed every place at the one strictest level
+    that reached any, so a kitchen behind a narrow door waited until every other room was looked
+    in: s100002-added-0, -2, "the chair that is oak" reached at 24-28 m against a 17-20 m limit)."""
+    from capnav.explore.places import Place, room_places
+    from capnav.retrieval.query import parse_goals
+
+    walls = [Box((0.6, -3.0, 0.0), (0.75, -0.26, 2.5), 0, 0, (225, 225, 215)),
+             Box((0.6, 0.26, 0.0), (0.75, 3.0, 2.5), 0, 0, (225, 225, 215))]
+    world = walls + _room_a((-0.3, 2.0))[len(WALLS):]
+    agent = BoxAgent(world, -1.2, -0.8, 0.0)
+    s = ObjectSearch(first_map, agent, create_detector("sim", noise="oracle", seed=0), Retriever(first_map, _EMB[0]),
+                     SearchConfig())  # type: ignore[arg-type]
+    s._parsed = parse_goals("the lamp", _EMB[0])[0]  # type: ignore[arg-type]
+    s._looked_in = set()
+    s.explorer.begin(10**6)
+    s.explorer.observe()
+    s.explorer.look_around()
+    _, regions = room_places(first_map, "lamp", _EMB[0])  # type: ignore[arg-type]
+    in_a = Place((-1.8, 0.6), 99, 0.3, "a place in room A")
+    out = s._choices([in_a], [], regions)
+    cands, dist = out[0], out[1]
+    a = [d for c, d in zip(cands, dist, strict=True) if c is in_a]
+    assert a and math.isfinite(a[0])
+    beyond = [(c, d) for c, d in zip(cands, dist, strict=True) if c.xy[0] > 0.75 and math.isfinite(d)]
+    assert beyond, [(c.xy, c.why, d) for c, d in zip(cands, dist, strict=True)]
+    levels = out[2]
+    assert all(int(levels[list(cands).index(c)]) > 0 for c, _ in beyond)

@@ -146,3 +146,17 @@ def test_kind_words_too_broad_for_a_category_are_not_kinds():
     assert set(lex.kinds["appliance"]) == {"refrigerator", "stove", "washing machine"}
     assert set(lex.kinds["plumbing fixture"]) == {"sink", "toilet"}
     assert {"bed", "sofa", "wardrobe"} <= set(lex.kinds["furniture"])
+
+
+def test_indirect_attribute_words_come_from_wordnet_s_relations():
+    attrs = load_lexicon().attributes
+    assert attrs["boxy"] == ("shape", "rectangular", "gloss")  # "resembling a box in rectangularity"
+    assert attrs["oblong"][:2] == ("shape", "long") and attrs["rounded"] == ("shape", "round", "also_see")
+    assert attrs["see-through"] == ("material", "glass", "definition")  # glass: "a brittle transparent solid"
+    assert attrs["timber"] == ("material", "wood", "genus")
+    assert attrs["vermilion"][:2] == ("colour", "scarlet") and attrs["tangerine"][:2] == ("colour", "reddish orange")
+    assert attrs["squishy"][:2] == ("unobserved", "soft")
+    # A distance first ("far"), a colour that names a wood ("cherry"), words of other tables, and
+    # words no relation reaches stay out.
+    for word in ("far", "cherry", "velvety", "big", "straight", "clear", "comfy", "light blue"):
+        assert word not in attrs, word

@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from capnav.core.errors import CapNavError, InputError
 from capnav.core.frame import Frame
-from capnav.core.grid import FREE, UNKNOWN, GridSpec, OccupancyGrid
+from capnav.core.grid import FREE, OCCUPIED, UNKNOWN, GridSpec, OccupancyGrid
 from capnav.explore.frontier import Frontier, find_frontiers
 from capnav.explore.online_map import OnlineMap, OnlineMapConfig
 from capnav.explore.sighting import Sighting, lift
@@ -58,6 +58,7 @@ class ExplorerConfig:
     frontier_tile: float = 1.5  # m, longest side of one frontier cluster
     visited_radius: float = 0.75  # m, a frontier whose target is this close to a reached one is spent
     max_collisions: int = 4  # per drive, before the target is given up
+    max_slides: int = 3  # per waypoint: a blocked step is slid off (``_slide``) this often before a replan
     min_sighting_points: int = 10  # valid depth pixels a detection needs to be lifted
     goal_snap: float = 0.5  # m, a goal inside the inflated obstacles moves to the nearest free cell
     keyframe_turn_deg: float = 60.0  # look again after turning this much since the last look ...
@@ -148,13 +149,140 @@ class FrontierExplorer:
         if self.path_limit is not None and float(getattr(self.agent, "path_length", 0.0)) >= self.path_limit:
             self.budget = 0
         if not ok:
-            r = self.config.planner.robot_radius + 0.06
-            self.map.mark_obstacle((x + r * math.cos(yaw), y + r * math.sin(yaw)))
+            self._mark_contact(x, y, yaw)
         if not ok or self._is_keyframe(x, y, yaw):
             self.observe()
         else:
             self.new_sightings = []
         return ok
+
+    def _mark_contact(self, x: float, y: float, yaw: float) -> None:
+        """Record where a blocked forward step touched something.
+
+        Nothing the map knows within reach ahead: the obstacle is unseen (below the depth band, a
+        thin leg), straight ahead, as before. Something the map knows within reach in the half
+        plane ahead: the robot touched that, at its side (a step of a 30-degree heading grazing a
+        convex corner or a gap's side), and the mark goes on the line to it, just beyond the robot's
+        radius; a mark straight ahead would sit in free floor on the way (in the gap the robot was
+        passing through) and close it to the next plan, while a mark at the touched side makes the
+        next plan keep the robot's true clearance there."""
+        r = self.config.planner.robot_radius
+        side = self._touched(x, y, yaw, r + 0.1)
+        if side is None:
+            self.map.mark_obstacle((x + (r + 0.06) * math.cos(yaw), y + (r + 0.06) * math.sin(yaw)))
+            return
+        self.map.mark_obstacle((x + (r + 0.06) * math.cos(side), y + (r + 0.06) * math.sin(side)), 0.05)
+
+    def _occupied_near(self, x: float, y: float, radius: float) -> NDArray[np.float64]:
+        """Centres (N, 2) of the online map's occupied cells within ``radius`` of (x, y)."""
+        spec = self.map.spec
+        rc = spec.to_cell(np.asarray((x, y), dtype=np.float64))
+        k = int(np.ceil(radius / spec.resolution)) + 1
+        r0, c0 = max(int(rc[0]) - k, 0), max(int(rc[1]) - k, 0)
+        r1, c1 = min(int(rc[0]) + k + 1, spec.rows), min(int(rc[1]) + k + 1, spec.cols)
+        if r0 >= r1 or c0 >= c1:
+            return np.zeros((0, 2))
+        win = self.map.cells(self.forgive_contacts)[r0:r1, c0:c1] == OCCUPIED
+        rr, cc = np.nonzero(win)
+        if rr.size == 0:
+            return np.zeros((0, 2))
+        pts = spec.to_world(np.stack([rr + r0, cc + c0], axis=1)).astype(np.float64)
+        return pts[np.hypot(pts[:, 0] - x, pts[:, 1] - y) <= radius]
+
+    def _touched(self, x: float, y: float, yaw: float, radius: float) -> float | None:
+        """The bearing of the nearest occupied cell within ``radius`` in the half plane ahead, or None."""
+        pts = self._occupied_near(x, y, radius)
+        if not len(pts):
+            return None
+        ahead = (pts[:, 0] - x) * math.cos(yaw) + (pts[:, 1] - y) * math.sin(yaw) > 0
+        if not ahead.any():
+            return None
+        pts = pts[ahead]
+        i = int(np.argmin(np.hypot(pts[:, 0] - x, pts[:, 1] - y)))
+        return math.atan2(pts[i, 1] - y, pts[i, 0] - x)
+
+    def _heading(self, k: int, target: tuple[float, float], d: float) -> int:
+        """The turn (in turn steps from the current heading) to take before the next forward step
+        towards ``target`` (``d`` metres away), nominally ``k`` (the heading nearest the bearing).
+
+        Why: paths are planned at a relaxed inflation (the bare radius less half a cell, so that a
+        door the robot fits through stays open) and simplified to straight lines that pass corners
+        at that inflation, and the robot follows them at the nearest 30-degree heading: a step
+        can then cut a convex corner closer than the robot's radius, and from there every first
+        step of every replan touches it again (s100001/s100002: "could not get to ... giving it
+        up", wedged between an ottoman and an armchair). So the step is checked against the
+        occupied cells of the robot's own map: when the nominal heading passes closer than the
+        radius plus half a cell (a cell's centre may lie half a cell off the surface), the
+        neighbouring headings (up to two turns away) that still get closer to the target are
+        tried, and the one that keeps the most clearance (up to that radius) is taken; none
+        clearer: the nominal heading, as before."""
+        r = self.config.planner.robot_radius
+        need = r + 0.5 * self.map.spec.resolution
+        x, y, yaw = (float(v) for v in self.agent.pose)
+        pts = self._occupied_near(x, y, self.forward + need + self.map.spec.resolution)
+        if not len(pts):
+            return k
+        ts = np.linspace(0.2, 1.0, 5)
+
+        def clear(j: int) -> float:
+            h = yaw + j * self.turn
+            sx, sy = x + ts * self.forward * math.cos(h), y + ts * self.forward * math.sin(h)
+            dd = np.hypot(sx[:, None] - pts[None, :, 0], sy[:, None] - pts[None, :, 1])
+            return float(dd.min())
+
+        def gain(j: int) -> float:
+            h = yaw + j * self.turn
+            return d - math.dist((x + self.forward * math.cos(h), y + self.forward * math.sin(h)), target)
+
+        c0 = clear(k)
+        if c0 >= need:
+            return k
+        best, best_key = k, (min(c0, need), 0.0)
+        for j in (k - 1, k + 1, k - 2, k + 2):
+            if gain(j) < 0.02:  # a step that does not get closer to the target is no way there
+                continue
+            c = clear(j)
+            key = (min(c, need), -abs(j - k))
+            if key[0] > best_key[0] + 0.005 or (key[0] >= need and best_key[0] < need):
+                best, best_key = j, key
+        return best
+
+    def _slide(self, target: tuple[float, float], stop: StopCheck | None) -> bool:
+        """After a blocked forward step, slide off what was touched as a bumper robot does: turn to
+        the heading that gets closest to ``target`` among those that leave the contact (at least a
+        right angle from its bearing, ``_touched``; straight ahead when the map knows nothing
+        there) and step. True when that step got closer to ``target``.
+
+        Why: a blocked step stops at the contact, and every replan from there heads into the same
+        corner at the nearest 30-degree heading (s100001/s100002: "could not get to ... giving it
+        up" 3-5 times without moving); a step that leaves the contact goes past it, and the
+        partial steps of the contacts also set the robot off the 0.25 m lattice of its steps, which
+        is what gets it through a gap a few centimetres wider than itself."""
+        r = self.config.planner.robot_radius
+        x, y, yaw = (float(v) for v in self.agent.pose)
+        phi = self._touched(x, y, yaw, r + 0.1)
+        phi = yaw if phi is None else phi
+        d0 = math.dist((x, y), target)
+        n = max(1, round(2 * math.pi / self.turn))
+        best: tuple[float, int] | None = None
+        for j in range(-(n // 2), n // 2 + 1):
+            h = yaw + j * self.turn
+            if math.cos(h - phi) > -0.05:  # would press into the contact
+                continue
+            g = d0 - math.dist((x + self.forward * math.cos(h), y + self.forward * math.sin(h)), target)
+            if g > 0.02 and (best is None or (g, -abs(j)) > (best[0], -abs(best[1]))):
+                best = (g, j)
+        if best is None:
+            return False
+        j = best[1]
+        for _ in range(abs(j)):
+            if self.budget <= 0:
+                return False
+            self.act("turn_left" if j > 0 else "turn_right")
+        if self.budget <= 0:
+            return False
+        self.act("move_forward")
+        return math.dist(self.xy, target) < d0 - 1e-3
 
     def _is_keyframe(self, x: float, y: float, yaw: float) -> bool:
         if self._looked_from is None:
@@ -286,6 +414,8 @@ class FrontierExplorer:
         reach = 0.6 * self.forward
         for wp in waypoints[1:]:
             target = (float(wp[0]), float(wp[1]))
+            turns: int | None = None  # turns left before the next forward step (``_heading``)
+            slides = 0
             while (d := math.dist(self.xy, target)) > reach:
                 if math.dist(self.xy, goal_xy) <= tol:
                     return Status.ARRIVED
@@ -294,17 +424,24 @@ class FrontierExplorer:
                 if self.budget <= 0:
                     return Status.BUDGET
                 x, y, yaw = (float(v) for v in self.agent.pose)
-                err = _wrap(math.atan2(target[1] - y, target[0] - x) - yaw)
+                if turns is None:
+                    err = _wrap(math.atan2(target[1] - y, target[0] - x) - yaw)
+                    turns = self._heading(round(err / self.turn), target, d)
                 progressed = True
-                if abs(err) > self.turn / 2:
-                    ok = self.act("turn_left" if err > 0 else "turn_right")
+                if turns != 0:
+                    ok = self.act("turn_left" if turns > 0 else "turn_right")
+                    turns -= 1 if turns > 0 else -1
                 else:
                     ok = self.act("move_forward")
                     forward += 1
+                    turns = None
                     progressed = math.dist(self.xy, target) < d - 1e-3
                 if stop is not None and stop(self):
                     return Status.STOPPED
                 if not ok:
+                    if slides < self.config.max_slides and self._slide(target, stop):
+                        slides += 1
+                        continue
                     return Status.BLOCKED
                 if not progressed:
                     break

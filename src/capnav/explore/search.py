@@ -173,6 +173,8 @@ class ObjectSearch:
         self._answered: dict[int, MapObject] = {}  # saved objects that were the answer at some time
         self._spots: list[tuple[float, float]] = []  # where the robot looked around
         self._cells_at: tuple[int, np.ndarray] | None = None  # the online map's cells, at a number of views
+        self._held: Answer | None = None  # a confirmed answer to a superlative that a saved object gone outranks
+        self._released: set[int] = set()  # answers held back once and then taken: never held again
 
     # ------------------------------------------------------------------ the request
     def run(self, instruction: str | ParsedQuery, first: QueryResult | None = None) -> SearchResult:
@@ -214,7 +216,9 @@ class ObjectSearch:
         self._spots.append(ex.xy)  # looked around where the request was heard
         while not self._over(None):
             ans = self._ask(force=True)
-            if ans.kind in ("new", "confirmed") and ans.obj is not None:
+            if self._hold(ans):
+                ans = Answer("none", None, f"{ans.reason} (held back: {self._held_why})", ans.seen)
+            elif ans.kind in ("new", "confirmed") and ans.obj is not None:
                 res = self._approach(ans)
                 if res is not None:
                     return res
@@ -222,19 +226,30 @@ class ObjectSearch:
             if ans.kind == "saved" and ans.obj is not None:
                 self._check_place(ans.obj)
                 continue
-            cands, dist, level = self._choices(places, visited, regions)
+            cands, dist, levels = self._choices(places, visited, regions)
+            utility = np.array([p.prior for p in cands]) / (1.0 + dist / cfg.distance_scale)
+            utility[~np.isfinite(dist)] = -1.0
+            if self._held is not None and (not cands or utility.max() < 0):
+                held, self._held = self._held, None
+                if held.obj is not None:
+                    self._released.add(held.obj.id)
+                self._log("search", f"no place left to look for what outranks it; taking {held.reason}", ex.xy)
+                res = self._approach(held)
+                if res is not None:
+                    return res
+                continue
             if not cands:
                 return self._end(f"not found: every place worth looking was looked at ({len(visited)} places, "
                                  f"{ex.looks} views) and {self._none_text(ans)}")
-            utility = np.array([p.prior for p in cands]) / (1.0 + dist / cfg.distance_scale)
-            utility[~np.isfinite(dist)] = -1.0
             k = int(np.argmax(utility))
             if utility[k] < 0:
                 return self._end(f"not found: no place left to look from can be reached ({len(visited)} places "
                                  f"looked from, {ex.looks} views, also with {self._levels[-1].describe()})")
+            level = int(levels[k])
             lvl = self._levels[level]
             if level > 0:
-                self._log("search", f"nothing to look from is reachable with {self._levels[0].describe()} (a gap "
+                self._log("search", f"({cands[k].xy[0]:.2f}, {cands[k].xy[1]:.2f}) is not reachable with "
+                                    f"{self._levels[0].describe()} (a gap "
                                     f"narrower than the robot and its margin, or closed by a contact mark); "
                                     f"planning with {lvl.describe()}", ex.xy)
             p = cands[k]
@@ -257,6 +272,56 @@ class ObjectSearch:
                 self._spots.append(ex.xy)
                 ex.look_around(self._stop)
         return self._out_of_budget()
+
+    def _hold(self, ans: Answer) -> bool:
+        """Hold back a saved object confirmed at its place as the answer to a superlative ("the
+        biggest plant") while a saved object of its kind that outranks it was seen gone from its
+        place, or not at it: that one was carried somewhere, and is the answer wherever it stands
+        now. The search goes on for it (a bigger one seen is the retriever's answer), until no
+        place is left to look or half the budget is driven; then the held answer is taken.
+
+        Why: on seed 100 "the biggest houseplant" and "the largest plant" (twice) were answered by a
+        saved plant confirmed at its place, while the biggest, which the map had seen gone from its
+        old place, stood unseen in another room: a superlative is only as good as the part of the
+        home seen, and the map says which part of it a better candidate left."""
+        if self._held is not None and ans.kind == "confirmed" and ans.same(self._held):
+            if self.driven() < 0.5 * self.config.budget_m:
+                return True
+            self._log("search", f"half the budget driven; taking {ans.reason}", self.explorer.xy)
+            self._held = None
+            if ans.obj is not None:
+                self._released.add(ans.obj.id)
+            return False
+        rival = self._outranks(ans)
+        if rival is None:
+            return False
+        self._held = ans
+        what = rival.caption or rival.label
+        self._held_why = (f"object {rival.id} ({what}) would be {self._parsed.superlative}, and it was seen gone "
+                          f"from its place at ({rival.position[0]:.2f}, {rival.position[1]:.2f}): looking for it")
+        self._log("search", f"{ans.reason}; held back: {self._held_why}", _xy(rival))
+        return True
+
+    def _outranks(self, ans: Answer) -> MapObject | None:
+        """The saved object of the answer's kind, seen gone or not at its place, that a superlative
+        request would rank above a confirmed answer (by more than a tenth), if any."""
+        q, snap, o = self._parsed, self._snap, ans.obj
+        if q.superlative not in ("largest", "smallest") or ans.kind != "confirmed" or o is None or snap is None:
+            return None
+        if (self._held is not None and ans.same(self._held)) or o.id in self._released:
+            return None
+
+        def measure(m: MapObject) -> float:
+            ext = np.asarray(m.extent_max, np.float64) - np.asarray(m.extent_min, np.float64)
+            return float(ext[2]) if q.size_axis == "height" else float(np.prod(np.maximum(ext, 1e-3)))
+
+        mine = measure(o)
+        gone = snap.gone | self.live.absent
+        rivals = [m for m in self.cmap.objects if m.id in gone and m.id != o.id and m.label == o.label
+                  and (measure(m) > 1.1 * mine if q.superlative == "largest" else measure(m) < mine / 1.1)]
+        if not rivals:
+            return None
+        return max(rivals, key=measure) if q.superlative == "largest" else min(rivals, key=measure)
 
     def _go(self, p: Place, lvl: Level) -> Status:
         """Drive to a place to look from (an object seen: to a step back from it)."""
@@ -308,31 +373,46 @@ class ObjectSearch:
         return False
 
     def _choices(self, places: Sequence[Place], visited: Sequence[tuple[float, float]],
-                 regions: np.ndarray) -> tuple[list[Place], np.ndarray, int]:
-        """Places worth looking from, their path lengths, and the level planned with: the strictest
-        of ``levels.search_levels`` from which any of them can be reached (a relaxed level may also
-        open frontiers beyond a narrow gap)."""
+                 regions: np.ndarray) -> tuple[list[Place], np.ndarray, np.ndarray]:
+        """Places worth looking from, their path lengths, and for each the level to plan with: the
+        strictest of ``levels.search_levels`` at which it can be reached (a relaxed level may also
+        open frontiers beyond a narrow gap: those a stricter level does not have).
+
+        Why per place: with one level for all (the strictest that reached any place), the kitchen
+        whose door only the bare radius fits through was never weighed while any place in the
+        first rooms was reachable with the margin, and the search looked in every other room first
+        (s100002-added-0, -2: "the chair that is oak" reached at 24-28 m against a 17-20 m limit)."""
         cfg, ex = self.config, self.explorer
-        first: tuple[list[Place], np.ndarray, int] | None = None
+        out: list[Place] = []
+        dist: list[float] = []
+        lv: list[int] = []
+        fixed = [p for p in places if not self._spent(p, visited, regions)] + self._second_looks(visited)
+        todo = list(range(len(fixed)))
         for level, lvl in enumerate(self._levels):
             ex.forgive_contacts = lvl.forgive_contacts
             grid = ex.grid()
             ex.forgive_contacts = False
             cm = ex.costmap(grid, lvl.planner)
-            cands = [p for p in places if not self._spent(p, visited, regions)]
-            fronts = ex.frontiers(grid, cm)
-            cands += [Place(f.target_xy, -1, cfg.frontier_prior * min(1.0, f.size / cfg.frontier_cells),
+            fronts = [Place(f.target_xy, -1, cfg.frontier_prior * min(1.0, f.size / cfg.frontier_cells),
                             f"a frontier of unseen space ({f.size} cells)")
-                      for f in fronts if all(math.dist(f.target_xy, v) > ex.config.visited_radius for v in visited)]
-            cands += self._second_looks(visited)
+                      for f in ex.frontiers(grid, cm)
+                      if all(math.dist(f.target_xy, v) > ex.config.visited_radius for v in visited)
+                      and all(math.dist(f.target_xy, q.xy) > ex.config.visited_radius
+                              for q, lq in zip(out, lv, strict=True) if q.region == -1 and lq < level)]
+            cands = [fixed[i] for i in todo] + fronts
             reach = [cfg.second_look_m if p.region == SECOND_LOOK else cfg.place_reach for p in cands]
-            dist = path_lengths(grid, cm, ex.xy, [p.xy for p in cands], lvl.planner, reach) if cands else np.zeros(0)
-            if np.isfinite(dist).any():
-                return cands, dist, level
-            if first is None or (cands and not first[0]):
-                first = (cands, dist, level)
-        assert first is not None
-        return first
+            d = path_lengths(grid, cm, ex.xy, [p.xy for p in cands], lvl.planner, reach) if cands else np.zeros(0)
+            last = level == len(self._levels) - 1
+            left = []
+            for j, p in enumerate(cands):
+                if np.isfinite(d[j]) or (last and j < len(todo)):
+                    out.append(p)
+                    dist.append(float(d[j]))
+                    lv.append(level)
+                elif j < len(todo):
+                    left.append(todo[j])
+            todo = left
+        return out, np.asarray(dist, np.float64), np.asarray(lv, np.int64)
 
     def _second_looks(self, visited: Sequence[tuple[float, float]]) -> list[Place]:
         """Objects of the requested kind the robot saw that the retriever did not take: a first
@@ -501,6 +581,8 @@ class ObjectSearch:
             return True
         prev = self._answer
         ans = self._ask()
+        if self._held is not None and ans.kind == "confirmed" and ans.same(self._held):
+            return False  # still the answer held back (``_hold``): drive on to look for what outranks it
         return ans is not prev and (ans.kind in ("new", "confirmed") or not ans.same(prev))
 
     def _approach(self, ans: Answer) -> SearchResult | None:

@@ -62,6 +62,10 @@ class Lexicon:
     height_superlatives: dict[str, str] = field(default_factory=dict)
     #: room word -> room type (WordNet's rooms, see build_lexicon): "guest room", "kitchenette"
     rooms: dict[str, str] = field(default_factory=dict)
+    #: an adjective WordNet relates to an attribute the map reads -> (kind, value, relation):
+    #: "boxy" (shape, rectangular, gloss), "see-through" (material, glass, definition), "azure"
+    #: (colour, blue, hypernym), "squishy" (unobserved, soft, similar_to); see build_lexicon
+    attributes: dict[str, tuple[str, str, str]] = field(default_factory=dict)
     load_seconds: float = 0.0
 
     def category_alternatives(self, category: str, form: str | None = None) -> dict[str, float]:
@@ -101,7 +105,8 @@ def load_lexicon() -> Lexicon:
                   placing=frozenset(raw.get("placing", [])), body=frozenset(raw.get("body", [])),
                   materials=dict(raw.get("materials", {})), heights=dict(raw.get("heights", {})),
                   height_superlatives=dict(raw.get("height_superlatives", {})),
-                  rooms=dict(raw.get("rooms", {})))
+                  rooms=dict(raw.get("rooms", {})),
+                  attributes={k: (v[0], v[1], v[2]) for k, v in raw.get("attributes", {}).items()})
     object.__setattr__(lex, "load_seconds", time.perf_counter() - t0)
     return lex
 

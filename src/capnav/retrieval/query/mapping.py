@@ -19,6 +19,7 @@ from capnav.retrieval.query.count import read_count, without
 from capnav.retrieval.query.model import ACROSS, BETWEEN, ROOM_WITH, ParsedQuery
 from capnav.retrieval.query.parse import _GENERIC, ROOM_ALONG, GoalParse, describe
 from capnav.retrieval.query.tokens import (
+    _COLOUR_OF,
     _COMMON_ADJECTIVES,
     _FILLER,
     _GROWTH,
@@ -31,6 +32,7 @@ from capnav.retrieval.query.tokens import (
     _SHAPES,
     _SIZE_TOKENS,
     _SUPERLATIVE,
+    UNOBSERVED,
     _colors,
     _find_category,
     _fix_keyword_typos,
@@ -38,6 +40,8 @@ from capnav.retrieval.query.tokens import (
     _other_object,
     _room_before,
     _size_word,
+    attribute_word,
+    material_of,
     materials_in,
     size_axis,
     validate_instruction,
@@ -50,6 +54,8 @@ if TYPE_CHECKING:
 _NEGATION = re.compile(r"(?:\b(?:that|which|who)\s+)?(?:\bis\s+not\b|\bisn't\b|\bisnt\b|\bnot\b|\bother\s+than\b"
                        r"|\bexcept(?:\s+for)?\b|\bapart\s+from\b|\brather\s+than\b|\binstead\s+of\b)"
                        r"\s+(?P<neg>[^,;]+?)(?=\s*(?:[,;]|\bbut\b|\bthe\s+other\b|$))")
+#: "non-leather", "non wooden": the prefix negates an attribute word.
+_NON = re.compile(r"\bnon\s*-?\s*([a-z]+(?:-[a-z]+)?)\b")
 #: The robot itself as the reference of closest / farthest.
 _SELF = re.compile(r"^(?:me|you|us|here|yourself|the robot|where i am|where you are|my position|"
                    r"your position)\b")
@@ -285,6 +291,25 @@ def _put_down(words: list[str]) -> bool:
                or (w.endswith("ed") and is_placing(w[:-2])) for i, w in enumerate(words))
 
 
+_PAST = re.compile(r"\b(?:past|via)\s+" + _ARTICLE)
+
+
+def _passed_objects(q: ParsedQuery, head: str) -> str:
+    """An object walked past before any object is named ("go past the sofa and stop at the
+    bookshelf") is passed, not the goal, when another object is named after it: its phrase is
+    taken out, with a note. "The lamp past the sofa" names its target first and keeps the phrase."""
+    for m in list(_PAST.finditer(head))[::-1]:
+        before, after = head[:m.start()].split(), head[m.end():].split()
+        cat, span, _ = _find_category(after)
+        if cat is None or span is None or span[0] != 0 or _find_category(before)[0] is not None:
+            continue
+        if _find_category(after[span[1]:])[0] is None:
+            continue
+        q.notes.append(f"the {' '.join(after[:span[1]])} is passed on the way, not the goal")
+        head = " ".join([*before, *after[span[1]:]])
+    return head
+
+
 def _shapes(words: list[str]) -> list[str]:
     """The shapes ``words`` name, once each. "Corner" is a shape only right before an object's
     name ("the corner sofa"); "in the corner" says where a thing stands."""
@@ -350,6 +375,12 @@ def _negations(q: ParsedQuery, head: str) -> str:
             q.negations.append(" ".join(words))
             continue
         cat, span, _ = _find_category(words)
+        before = _find_category(out[: m.start()].split())[0]
+        if cat is not None and before is not None and before != cat:
+            # "the sink, not the bathtub": another kind than the one asked for is excluded whole.
+            out = out[: m.start()] + " " + out[m.end():]
+            q.negations.append(" ".join(w for w in words if w not in _DETERMINERS))
+            continue
         if cat is not None and span is not None:
             out = out[: m.start()] + " " + " ".join(words[span[0]:span[1]]) + " " + out[m.end():]
             words = words[:span[0]] + words[span[1]:]
@@ -430,9 +461,17 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     norm = re.sub(r"[^a-z0-9\-',; ]+", " ", low).replace(",", " , ").replace(";", " ; ")
     norm = re.sub(r"\b(\w+)n't\b", r"\1 not", norm.replace("isn't", "is not").replace("isnt", "is not"))
     norm = " ".join(_fix_keyword_typos(norm.replace("'s", "").split()))
+    # "the non-leather sofa": the prefix negates that attribute word alone (not the clause after it).
+    non = [x for x in _NON.finditer(norm) if attribute_word(x.group(1))]
+    for x in non[::-1]:
+        norm = norm[: x.start()] + norm[x.end():]
+    norm = " ".join(norm.split())
     q = ParsedQuery(text=t)
     head = " ".join(re.sub(r"[,;]", " ", _negations(q, norm)).split())
     norm = " ".join(re.sub(r"[,;]", " ", norm).split())
+    q.negations += [x.group(1) for x in non]
+    # "go past the sofa and stop at the bookshelf": the sofa is passed on the way.
+    head = _passed_objects(q, head)
     # "somewhere to rest my plate while we watch the tv": the tv is where, not what.
     head = _purpose_context(q, head)
     # "somewhere right by the bed to put my glass": the landmark of the place asked for.
@@ -550,7 +589,11 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     known = (set(_FILLER) | set(LEXICON) | set(ALIASES) | set(_SHAPES) | _SIZE_TOKENS | set(_SUPERLATIVE)
              | set(_MATERIAL_OF) | _COMMON_ADJECTIVES | {w for c in q.colors for w in c.split()}
              | (_GROWTH_TOKENS if cat == "plant" else set())
-             | {w for w in words if re.fullmatch(r"[a-z]+-colou?red", w)})
+             | {w for w in words if re.fullmatch(r"[a-z]+-colou?red", w) or material_of(w)}
+             | set(UNOBSERVED) | {w for w in words if w in _COLOUR_OF and _COLOUR_OF[w] in q.colors})
+    for w in dict.fromkeys(w for w in words if w in UNOBSERVED):
+        # "the squishy armchair": WordNet's soft; no map observes it, so it neither confirms nor refuses.
+        q.notes.append(f"'{w}' says {UNOBSERVED[w]}, which the map does not observe")
     if cat is not None and span is not None:
         form = " ".join(words[span[0]:span[1]])
         q.category_alternatives = _LEX.category_alternatives(cat, None if fuzzy else form)

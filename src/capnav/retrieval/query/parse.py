@@ -240,8 +240,19 @@ def split_goals(text: str) -> list[str]:
 def _names_goal(piece: str, after_sequence_word: bool) -> bool:
     words = re.findall(r"[a-z][a-z\-']*", piece.lower())
     cat, _, _ = _find_category(words)
+    if cat is not None and _only_passed(words):
+        return False  # "drive past the tv, then stop by the armchair": the tv is on the way
     return cat is not None or find_activity(piece.lower()) is not None or bool(_GENERIC.intersection(words)) \
         or (after_sequence_word and _unknown_object(words))
+
+
+def _only_passed(words: list[str]) -> bool:
+    """Whether the only object ``words`` name is walked past ("go past the sofa")."""
+    k = next((i for i, w in enumerate(words) if w in ("past", "via")), None)
+    if k is None or _find_category(words[:k])[0] is not None:
+        return False
+    _, span, _ = _find_category(words[k + 1:])
+    return span is not None and _find_category(words[k + 1 + span[1]:])[0] is None
 
 
 #: Words that point back at an object already named ("go there", "take me to it", "that one").

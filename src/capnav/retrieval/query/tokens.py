@@ -135,6 +135,14 @@ _SHAPES = {"round": "round", "circular": "round", "l-shaped": "L-shaped", "l sha
            # the growth words the offline captioner says of a plant (capnav.language.form): a bush
            # is leafy (its points do not tell it from a leafy crown on a stem)
            "leafy": "leafy", "bushy": "leafy", "slender": "slender"}
+#: Adjectives WordNet relates to a shape word ("boxy", "oblong", "disc-shaped", "rounded"; the
+#: lexicon's ``attributes``); the hand table above wins where both have a word.
+_SHAPES = {**{w: v for w, (kind, v, _) in _LEX.attributes.items() if kind == "shape" and " " not in w}, **_SHAPES}
+#: Words of a property no map observes ("squishy", "padded": soft): read, neither confirm nor refuse.
+UNOBSERVED = {w: v for w, (kind, v, _) in _LEX.attributes.items() if kind == "unobserved" and " " not in w}
+#: Colour words beyond the colour tables, as their nearest colour ("vermilion" scarlet, "azure"
+#: light blue, "tangerine" reddish orange; the lexicon's ``attributes``).
+_COLOUR_OF = {w: v for w, (kind, v, _) in _LEX.attributes.items() if kind == "colour"}
 #: Words that name a plant's growth form ("cactus", "succulent", "prickly"; WordNet's, the lexicon)
 #: -> the growth word the captioner measures ("slender").
 _GROWTH = _LEX.growth
@@ -154,13 +162,27 @@ _MATERIALS = {"wooden", "wood", "leather", "fabric", "velvet", "metal", "glass",
               "ceramic", "stainless", "steel", "laminate", "cotton", "acrylic", "paper", "terracotta", "chrome"}
 #: Every other material word WordNet has, spoken as the material the surface test knows
 #: ("velvety" -> velvet, "suede" -> leather, "teak" -> wood; the lexicon's ``materials``).
-_MATERIAL_OF = {**_LEX.materials, **{w: w for w in _MATERIALS}}
+#: Adjectives and nouns WordNet relates to a material otherwise ("see-through": glass, its
+#: definition's "transparent"; "timber": wood, its definition's genus; the lexicon's ``attributes``).
+_MATERIAL_OF = {**{w: v for w, (kind, v, _) in _LEX.attributes.items() if kind == "material" and " " not in w},
+                **_LEX.materials, **{w: w for w in _MATERIALS}}
+
+
+def material_of(word: str) -> str | None:
+    """The material ``word`` names: a material word, or a hyphenated modifier whose first part is
+    one and whose last is a participle ("wooden-topped", "leather-covered", "glass-fronted")."""
+    if word in _MATERIAL_OF:
+        return _MATERIAL_OF[word]
+    parts = word.split("-")
+    if len(parts) > 1 and parts[0] in _MATERIAL_OF and parts[-1].endswith("ed") and len(parts[-1]) > 3:
+        return _MATERIAL_OF[parts[0]]
+    return None
 
 
 def materials_in(words: list[str]) -> list[str]:
     """The materials ``words`` name, once each, in order: the plain words as spoken, the others
-    as the material they are ("a velvety suede chair" -> velvet, leather)."""
-    return list(dict.fromkeys(_MATERIAL_OF[w] for w in words if w in _MATERIAL_OF))
+    as the material they are ("a velvety suede chair" -> velvet, leather; "wooden-topped" wood)."""
+    return list(dict.fromkeys(m for w in words if (m := material_of(w)) is not None))
 _FILLER = {"go", "to", "the", "a", "an", "please", "find", "navigate", "take", "me", "walk", "head", "move",
            "drive", "could", "you", "can", "would", "kindly", "toward", "towards", "over", "there", "that",
            "one", "of", "is", "which", "i", "want", "need", "get", "bring", "robot", "hey", "and", "with",
@@ -276,7 +298,7 @@ def _find_vocabulary(words: list[str]) -> tuple[str | None, tuple[int, int] | No
     for i, w in enumerate(words):
         if len(w) < 4 or w in _FILLER or canonical_color(w) or w in _SHAPES or w in _SIZE_WORDS \
                 or w in _LEX.not_typos or w in LABEL_MAP or w in _FORM_MAP or not w.isalpha() \
-                or w in _COMMON_ADJECTIVES or w in _ENGLISH_HINTS:
+                or w in _COMMON_ADJECTIVES or w in _ENGLISH_HINTS or w in _LEX.attributes:
             continue
         near = _nearest(w, _SINGLE_BY_LETTER.get(w[0], []))
         # A word two or more letters short of a name's start is another word, not a typo ("wash").
@@ -302,7 +324,9 @@ def _color_name(phrase: str) -> str | None:
     name = canonical_color(phrase)
     if name is not None:
         return name
-    return phrase if color_lab(phrase) is not None else None
+    if color_lab(phrase) is not None:
+        return phrase
+    return _COLOUR_OF.get(phrase)
 
 
 def _colors(words: list[str]) -> list[str]:
@@ -353,7 +377,7 @@ def _fix_keyword_typos(words: list[str]) -> list[str]:
     out = []
     for w in words:
         if w in _ENGLISH_HINTS or w in _FORM_WORDS or w in _LEX.not_typos or w in _COMMON_ADJECTIVES \
-                or not w.isalpha() or len(w) < 3:
+                or w in _LEX.attributes or not w.isalpha() or len(w) < 3:
             out.append(w)
             continue
         fixed = None
@@ -419,5 +443,5 @@ def attribute_word(word: str) -> bool:
     """Whether the mapping would read ``word`` as an attribute of the target: a colour, shape,
     size, material or growth word ("blue", "round", "big", "velvet", "prickly")."""
     w = word.lower()
-    return bool(w in _SHAPES or w in _SIZE_WORDS or w in _SUPERLATIVE or w in _MATERIAL_OF or w in _GROWTH
+    return bool(w in _SHAPES or w in _SIZE_WORDS or w in _SUPERLATIVE or material_of(w) or w in _GROWTH
                 or _color_name(w))
