@@ -370,3 +370,89 @@ def family(word: str, radius: float = FAMILY_RADIUS) -> tuple[str, ...]:
             if BASIC[k] == name and d[k] <= radius and d[second] >= FAMILY_MARGIN * d[k]:
                 out.append(n)
     return tuple(out)
+
+
+# -- a plain hue word covers its dark shades ------------------------------------------------------
+
+#: CIELAB chroma above which a basic term names a hue. White, grey and black (chroma under 3) have
+#: none: their lightness is what tells them apart, so a darker white is grey, never "a dark white".
+HUE_CHROMA = 20.0
+#: Agreement lost per unit of darkening along a hue's shade ray (at t = 0.7, a navy for "blue",
+#: 0.91 of its agreement with the ray point): the word's own colour still ranks first when both
+#: a blue and a navy object are in the map.
+DARK_DISCOUNT = 0.3
+_RAY_T = np.round(np.arange(1.0, 0.19, -0.05), 2)  # lightness factors along the ray, focal first
+_RAY_S = (1.0, 1.25)  # chroma factors: the focal chroma and a more saturated shade
+
+
+@lru_cache(maxsize=64)
+def shade_ray(word: str) -> tuple[tuple[tuple[float, float, float], float], ...]:
+    """The dark and saturated shades a plain basic hue term covers, as (CIELAB point, lightness
+    factor t) pairs, the word's own colour first: its focal colour scaled towards black (t * Lab,
+    what a darker surface of the same chromaticity is, navy for blue, forest green for green) and a
+    more saturated version of each, for as long as the shade belongs to the term by the family rule
+    (nearest basic term, every other one ``FAMILY_MARGIN`` times farther: a dark orange becomes
+    brown and leaves "orange"). Any other word (an achromatic term, a shade word, a colour with a
+    lightness modifier such as "light blue" or "dark blue") has its own point only."""
+    w = word.strip().lower()
+    name = canonical_color(w)
+    lab = color_lab(w)
+    if lab is None:
+        return ()
+    focal = np.asarray(lab, dtype=np.float64)
+    out = [((float(focal[0]), float(focal[1]), float(focal[2])), 1.0)]
+    if name not in BASIC or float(np.hypot(focal[1], focal[2])) < HUE_CHROMA:
+        return tuple(out)
+    own = BASIC.index(name)
+    for s in _RAY_S:
+        for t in _RAY_T:
+            if t == 1.0 and s == 1.0:
+                continue
+            p = np.array([focal[0] * t, focal[1] * t * s, focal[2] * t * s])
+            d = ciede2000(p[None], _BASIC_LAB, kL=2.0)
+            others = np.delete(d, own)
+            if int(np.argmin(d)) != own or float(others.min()) < FAMILY_MARGIN * float(d[own]):
+                break  # the shade has left the term; darker ones are farther still
+            out.append(((float(p[0]), float(p[1]), float(p[2])), float(t)))
+    return tuple(out)
+
+
+def term_agreement(word: str, lab: NDArray[np.floating] | tuple[float, float, float], scale: float = 12.0,
+                   kL: float = 2.0) -> float:
+    """How well a spoken colour fits a measured colour, in (0, 1], counting the dark shades a plain
+    hue term covers (``shade_ray``): the best exp(-ΔE00 / scale) over the word's own colour and its
+    shades, each shade's discounted by ``DARK_DISCOUNT`` per unit of darkening. "blue" fits a navy
+    object nearly as well as a blue one and a light blue one no better than ``color_agreement``
+    (lighter than the word's colour is not on the ray); every other word equals
+    ``color_agreement``."""
+    a = np.asarray(lab, dtype=np.float64).reshape(-1)
+    if a.shape != (3,):
+        raise InputError(f"a colour is 3 numbers, got {a.shape}")
+    return _term_agreement(word.strip().lower(), float(a[0]), float(a[1]), float(a[2]), float(scale), float(kL))
+
+
+@lru_cache(maxsize=65536)
+def _term_agreement(word: str, L: float, a: float, b: float, scale: float, kL: float) -> float:
+    ray = shade_ray(word)
+    if len(ray) <= 1:
+        return _agreement(word, L, a, b, scale, kL)
+    pts = np.array([p for p, _ in ray])
+    ts = np.array([t for _, t in ray])
+    d = ciede2000(np.array([L, a, b])[None], pts, kL=kL)
+    return float(np.max(np.exp(-d / scale) * (1.0 - DARK_DISCOUNT * (1.0 - ts))))
+
+
+#: Share of a lighter shade's agreement, against a darker one's, when the plain hue term was said:
+#: "blue" of a light blue object counts half of what it counts for a royal blue one, so a full or
+#: dark shade of the hue ranks first and "light blue" is what asks for the light one.
+LIGHT_SHADE_SHARE = 0.5
+
+
+def lighter_shade(word: str, shade: str) -> bool:
+    """Whether ``shade`` is a lighter shade of the hue term ``word`` (light blue, sky blue for
+    blue): the word names a hue (``HUE_CHROMA``) and the shade's lightness is above its colour's.
+    Never for white, grey or black, whose shades differ by lightness alone."""
+    w, s = color_lab(word), color_lab(shade)
+    if w is None or s is None or float(np.hypot(w[1], w[2])) < HUE_CHROMA:
+        return False
+    return float(s[0]) > float(w[0])

@@ -28,7 +28,7 @@ import numpy as np
 from capnav.core.errors import CapNavError
 from capnav.core.registry import Registry
 from capnav.language.captioner import RetryPolicy
-from capnav.language.colors import ColorCluster, color_agreement, family
+from capnav.language.colors import LIGHT_SHADE_SHARE, ColorCluster, family, lighter_shade, term_agreement
 from capnav.language.context import SceneContext, canonical_label
 from capnav.language.embedder import TextEmbedder
 from capnav.language.form import shape_conflict
@@ -137,8 +137,10 @@ class OfflineVerifierConfig:
     #: A colour cluster covering under half of the object counts from this floor up to 1 at half
     #: (0.2 separates true from wrong colour words better than 0.6: 95.0% vs 93.2% refused).
     color_floor: float = 0.2
-    #: A shade of the spoken colour (light blue for "blue") counts at this share, so the colour
-    #: itself wins when both are in the map.
+    #: A shade of the spoken colour (royal blue for "blue") counts at this share, so the colour
+    #: itself wins when both are in the map; a lighter shade of a hue (light blue for "blue") at
+    #: ``colors.LIGHT_SHADE_SHARE`` of it. The word's own agreement counts the hue's dark shades
+    #: (``colors.term_agreement``: navy for "blue").
     shade_weight: float = 0.5
     w_rank: float = 0.5
     w_color: float = 1.0
@@ -274,8 +276,9 @@ class OfflineVerifier(Verifier):
     def color(self, q: ParsedQuery, obj: MapObject, words: list[str] | None = None) -> tuple[float, str]:
         """Agreement in (0, 1] of the spoken colours (``words`` or the query's) with the object's
         observed colours (its base's for "the plant in the blue pot"); 0 and "" when none spoken.
-        A shade the word covers (``colors.family``: light blue for "blue", mustard for "yellow")
-        counts at ``shade_weight``, so the colour itself ranks first when both are in the map."""
+        A shade the word covers (``colors.family``: royal blue for "blue", mustard for "yellow")
+        counts at ``shade_weight`` (a lighter shade of a hue, light blue for "blue", at half that),
+        so the colour itself or a dark shade of it (navy, ``colors.term_agreement``) ranks first."""
         rank, _, why = self.color_fit(q, obj, words)
         return rank, why
 
@@ -302,9 +305,11 @@ class OfflineVerifier(Verifier):
         for word in words:
             shades = family(word)
             # (agreement, shade index, cluster) of every observed colour cluster against every shade.
-            vals = [(color_agreement(w, c.lab) * (floor + (1.0 - floor) * min(1.0, c.fraction / 0.5)), k, j)
+            vals = [(term_agreement(w, c.lab) * (floor + (1.0 - floor) * min(1.0, c.fraction / 0.5)), k, j)
                     for j, c in enumerate(cols) for k, w in enumerate(shades)]
-            rank, _, j = max((v * (1.0 if k == 0 else self.config.shade_weight), k, j) for v, k, j in vals)
+            share = [1.0] + [self.config.shade_weight * (LIGHT_SHADE_SHARE if lighter_shade(word, w) else 1.0)
+                             for w in shades[1:]]
+            rank, _, j = max((v * share[k], k, j) for v, k, j in vals)
             fit, k, jf = max(vals)
             ranks.append(rank)
             fits.append(fit)
