@@ -135,6 +135,19 @@ def offline_retriever(objects: list[MapObject], occupancy: OccupancyGrid | None 
     return Retriever(cmap, emb, create_verifier("offline", embedder=emb))
 
 
+
+def bedroom_and_lounge() -> Retriever:
+    """A bedroom (bed, lamp 2) and a lounge (sofa, tv, lamp 5) either side of a wall with a door:
+    the smallest scene in which a room word chooses between two lamps."""
+    objs = [
+        make_obj(1, "bed", (1.0, 1.5), (1.6, 2.0, 0.5), (200, 200, 210)),
+        make_obj(2, "lamp", (2.5, 4.5), (0.3, 0.3, 1.5), (230, 230, 220)),
+        make_obj(3, "sofa", (6.5, 1.0), (2.0, 0.9, 0.8), (90, 90, 100)),
+        make_obj(4, "tv", (6.5, 5.5), (1.0, 0.2, 0.6), (20, 20, 20)),
+        make_obj(5, "lamp", (5.0, 4.5), (0.3, 0.3, 1.5), (230, 230, 220)),
+    ]
+    return offline_retriever(objs, grid_with_wall(-1, -1, 9, 7, wall_x=4.0, door=(2.5, 3.5)))
+
 def described_living_map(folder: Path) -> Path:
     """The living scene (a wall with a door at x = 3.8) captioned offline, embedded with MiniLM
     and saved as ``folder/living.capnav``: the map the API and server tests read."""

@@ -11,19 +11,12 @@ from capnav.language.context import ROOM_SYNONYMS, room_ending, room_starting
 from capnav.language.lexicon import load_lexicon
 from capnav.retrieval import Retriever
 from capnav.retrieval.query import parse_instruction
-from language.synth import grid_with_wall, make_obj, offline_retriever
+from language.synth import bedroom_and_lounge
 
 
 @pytest.fixture(scope="module")
 def retriever() -> Retriever:
-    objs = [
-        make_obj(1, "bed", (1.0, 1.5), (1.6, 2.0, 0.5), (200, 200, 210)),
-        make_obj(2, "lamp", (2.5, 4.5), (0.3, 0.3, 1.5), (230, 230, 220)),
-        make_obj(3, "sofa", (6.5, 1.0), (2.0, 0.9, 0.8), (90, 90, 100)),
-        make_obj(4, "tv", (6.5, 5.5), (1.0, 0.2, 0.6), (20, 20, 20)),
-        make_obj(5, "lamp", (5.0, 4.5), (0.3, 0.3, 1.5), (230, 230, 220)),
-    ]
-    return offline_retriever(objs, grid_with_wall(-1, -1, 9, 7, wall_x=4.0, door=(2.5, 3.5)))
+    return bedroom_and_lounge()
 
 
 @pytest.mark.parametrize(("text", "oid"), [
