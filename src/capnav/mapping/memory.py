@@ -156,7 +156,10 @@ class ObjectMemory:
                 self._adopt(track, det, buf)
             if track.hits - self._restarted.get(track.id, 0) + self._inherited.get(track.id, 0) < h_min:
                 return None
-            oid = self._link(track, buf, busy)
+            # Linked by its own detections: pooled ones of a neighbour must not pull it onto that
+            # neighbour (two armchairs side by side), they only help confirm it.
+            own = buf[self._inherited.get(track.id, 0):]
+            oid = self._link(track, own or buf, busy)
             track.object_id = oid
             self._restarted.pop(track.id, None)
             self._inherited.pop(track.id, None)
