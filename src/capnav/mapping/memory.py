@@ -15,7 +15,7 @@ detection to their object. When the track dies the object stays. ``finish`` merg
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -158,13 +158,14 @@ class ObjectMemory:
                 return None
             # Linked by its own detections: pooled ones of a neighbour must not pull it onto that
             # neighbour (two armchairs side by side), they only help confirm it.
-            own = buf[self._inherited.get(track.id, 0):]
+            inherited = self._inherited.get(track.id, 0)
+            own = buf[inherited:]
             oid = self._link(track, own or buf, busy)
             track.object_id = oid
             self._restarted.pop(track.id, None)
             self._inherited.pop(track.id, None)
-            for d, o, f in self._pending.pop(track.id):
-                self._add(self.objects[oid], d, o, f)
+            for k, (d, o, f) in enumerate(self._pending.pop(track.id)):
+                self._add(self.objects[oid], self._within(d, own) if k < inherited else d, o, f)
             return oid
         obj = self.objects[track.object_id]
         if self.config.recheck and self._inconsistent(det.points, obj.points):
@@ -182,6 +183,17 @@ class ObjectMemory:
             obj = self.objects[other]
         self._add(obj, det, obs, frame)
         return track.object_id
+
+    def _within(self, det: LiftedDetection, own: list[tuple[LiftedDetection, Observation, int]]) -> LiftedDetection:
+        """A pooled detection's points within the track's own detections' box (``recheck_margin``
+        around it): a sighting that spilled onto a neighbour adds only this thing's surface."""
+        pts = [d.points for d, _, _ in own if len(d.points)]
+        if not pts or not len(det.points):
+            return det
+        ref = np.concatenate(pts)
+        m = self.config.recheck_margin
+        keep = np.all((det.points >= ref.min(axis=0) - m) & (det.points <= ref.max(axis=0) + m), axis=1)
+        return replace(det, points=det.points[keep], colors=det.colors[keep])
 
     def _inconsistent(self, pts: NDArray[np.float32], ref: NDArray[np.float32]) -> bool:
         cfg = self.config
