@@ -62,7 +62,10 @@ class MemoryConfig:
     free space between a wall, a bookshelf and a sofa whose way out, in the pooled map, is a
     strip no frame saw, so the pocket was reached from no room and only the office's cells across
     the wall voted in ``object_region``. Pockets now take the room they open into through unseen
-    cells (``language.rooms.room_regions``) and only cells joined to an object's own vote."""
+    cells (``language.rooms.room_regions``) and only cells joined to an object's own vote.
+    Pooled detections help confirm a thing, never decide which one it is: a pooled track is linked
+    by its own detections, and a pooled detection adds only its points within theirs (a sighting
+    that spilled over two armchairs side by side once grew one over the other)."""
 
     point_voxel: float = 0.03
     max_points: int = 3000
