@@ -17,7 +17,7 @@ from capnav.language.context import ROOM_SYNONYMS
 from capnav.language.purpose import find_activity, is_placing, match_purpose, purpose_categories
 from capnav.retrieval.query.count import read_count, without
 from capnav.retrieval.query.model import ACROSS, BETWEEN, ROOM_WITH, ParsedQuery
-from capnav.retrieval.query.parse import _GENERIC, ROOM_ALONG, GoalParse, describe
+from capnav.retrieval.query.parse import _GENERIC, ROOM_ALONG, GoalParse, describe, passed_object
 from capnav.retrieval.query.tokens import (
     _COLOUR_OF,
     _COMMON_ADJECTIVES,
@@ -286,28 +286,25 @@ def _clause_landmark(q: ParsedQuery, head: str) -> str:
 
 def _put_down(words: list[str]) -> bool:
     """Whether ``words`` hold a verb of putting a thing down (the lexicon's placing verbs,
-    WordNet's, in any inflection): what follows "on" is where it was put."""
-    return any(is_placing(" ".join(words[i:i + 2])) or (w.endswith("ed") and is_placing(w[:-1]))
-               or (w.endswith("ed") and is_placing(w[:-2])) for i, w in enumerate(words))
-
-
-_PAST = re.compile(r"\b(?:past|via)\s+" + _ARTICLE)
+    WordNet's, in any inflection; ``is_placing`` reads -ing and -s, the past tense is tried here):
+    what follows "on" is where it was put."""
+    for i, w in enumerate(words):
+        past = [w[:-1], w[:-2]] if w.endswith("ed") else []
+        if is_placing(" ".join(words[i:i + 2])) or any(is_placing(stem) for stem in past):
+            return True
+    return False
 
 
 def _passed_objects(q: ParsedQuery, head: str) -> str:
-    """An object walked past before any object is named ("go past the sofa and stop at the
-    bookshelf") is passed, not the goal, when another object is named after it: its phrase is
-    taken out, with a note. "The lamp past the sofa" names its target first and keeps the phrase."""
-    for m in list(_PAST.finditer(head))[::-1]:
-        before, after = head[:m.start()].split(), head[m.end():].split()
-        cat, span, _ = _find_category(after)
-        if cat is None or span is None or span[0] != 0 or _find_category(before)[0] is not None:
-            continue
-        if _find_category(after[span[1]:])[0] is None:
-            continue
-        q.notes.append(f"the {' '.join(after[:span[1]])} is passed on the way, not the goal")
-        head = " ".join([*before, *after[span[1]:]])
-    return head
+    """An object walked past before any object is named (``parse.passed_object``: "go past the
+    sofa and stop at the bookshelf") is passed, not the goal, when another object is named after
+    it: its phrase is taken out, with a note."""
+    words = head.split()
+    p = passed_object(words)
+    if p is None or _find_category(words[p[1]:])[0] is None:
+        return head
+    q.notes.append(f"the {' '.join(words[p[0] + 1:p[1]])} is passed on the way, not the goal")
+    return " ".join([*words[:p[0]], *words[p[1]:]])
 
 
 def _shapes(words: list[str]) -> list[str]:

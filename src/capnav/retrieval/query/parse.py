@@ -246,13 +246,21 @@ def _names_goal(piece: str, after_sequence_word: bool) -> bool:
         or (after_sequence_word and _unknown_object(words))
 
 
-def _only_passed(words: list[str]) -> bool:
-    """Whether the only object ``words`` name is walked past ("go past the sofa")."""
+def passed_object(words: list[str]) -> tuple[int, int] | None:
+    """The words (start, end) of an object walked past before any object is named: from "past" or
+    "via" to the end of the first object named after it ("go [past the big sofa] and stop at the
+    bookshelf"), else None. "The lamp past the sofa" names its target first: None."""
     k = next((i for i, w in enumerate(words) if w in ("past", "via")), None)
     if k is None or _find_category(words[:k])[0] is not None:
-        return False
+        return None
     _, span, _ = _find_category(words[k + 1:])
-    return span is not None and _find_category(words[k + 1 + span[1]:])[0] is None
+    return None if span is None else (k, k + 1 + span[1])
+
+
+def _only_passed(words: list[str]) -> bool:
+    """Whether the only object ``words`` name is walked past ("go past the sofa")."""
+    p = passed_object(words)
+    return p is not None and _find_category(words[p[1]:])[0] is None
 
 
 #: Words that point back at an object already named ("go there", "take me to it", "that one").
