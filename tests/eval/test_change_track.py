@@ -23,7 +23,8 @@ def test_episodes_per_change_class() -> None:
         kinds = {c.id: c.kind for c in s2.manifest.changes}
         present = {o.id for o in s2.manifest.objects}
         cats = {v: [o.category for o in s.manifest.objects] for v, s in ((1, s1), (2, s2))}
-    assert set(eps) == set(CLASSES) and all(len(e) == 8 for e in eps.values())
+    assert set(eps) == set(CLASSES) and eps["hidden"] == []  # no hidden=N in the spec
+    assert all(len(e) == 8 for c, e in eps.items() if c != "hidden")
     for cls, episodes in eps.items():
         for ep in episodes:
             (g,) = ep.subgoals
@@ -64,3 +65,26 @@ def test_track_runs_only_its_methods() -> None:
     assert ChangeTrackConfig(methods=("capnav-search",)).methods == ("capnav-search",)
     with pytest.raises(InputError, match="got capnav-magic"):
         ChangeTrackConfig(methods=("capnav-search", "capnav-magic"))
+
+
+def test_hidden_objects_are_described_where_visit_two_put_them() -> None:
+    """``hidden``: described as at visit 2 (in the room no frame of visit 2 shows), to be reached;
+    only the search methods are told to look for them beyond the map."""
+    from capnav.eval.change_track import SEARCH_CLASSES
+
+    cfg = ChangeTrackConfig(scenes=1, changes=ChangeSpec(moved=1, hidden=1), per_class=3)
+    sc = SimConfig(layout=LayoutConfig(rooms=3), camera=CameraConfig(width=64, height=48))
+    with Simulator.from_seed(2, sc) as s1, Simulator.from_seed(2, sc, visit=2, changes=cfg.changes) as s2:
+        nav = s2.navigable()
+        truth = SceneTruth.from_manifest(s2.manifest, nav.spec, nav.cells == FREE)
+        eps = _episodes(2, cfg, s1.manifest, s2.manifest, truth)
+        (hid,) = [c for c in s2.manifest.changes if c.kind == "hidden"]
+    assert len(eps["hidden"]) == 3
+    assert all(ep.subgoals[0].target_ids == [hid.id] for ep in eps["hidden"])
+    assert SEARCH_CLASSES["capnav-update-search"] == ("hidden",)
+    res = {"summaries": [{"method": "capnav-update-search", "protocol": "description/hidden", "independent": 1.0,
+                          "subgoals": 3}],
+           "update_search": {"subgoals": 3, "budget": "3x", "within_budget": 2, "reached_any_length": 3}}
+    out = table(res)
+    assert "| capnav-update-search | - | - | - | - | 100.0 (3) |" in out
+    assert "capnav-update-search (hidden): reached within 3x 2 of 3" in out

@@ -132,3 +132,26 @@ def test_the_simulator_detector_hands_out_no_instance_ids() -> None:
         return sorted((d.label, np.packbits(d.mask).tobytes()) for d in ds)
 
     assert key(det.detect(f)) == key(det.detect(g))
+
+
+def test_a_hidden_object_is_in_no_frame_of_the_visit(tmp_path: Path) -> None:
+    """``hidden=1``: one object carried into a room the visit never enters, and seen in none of its
+    frames (not even through the door), while everything else of the visit is recorded as usual."""
+    assert ChangeSpec.parse("moved=1,hidden=1") == ChangeSpec(moved=1, hidden=1)
+    assert str(ChangeSpec(moved=3, removed=2, added=2)) == "moved=3,removed=2,added=2"  # old specs' text
+    args = ["sim", "--seed", "2", "--width", "64", "--height", "48", "--rooms", "3", "--visit", "2"]
+    res = CliRunner().invoke(app, [*args, "--changes", "moved=1,hidden=1", "-o", str(tmp_path / "v2")])
+    assert res.exit_code == 0, res.output
+    r = DatasetReader(tmp_path / "v2")
+    assert r.manifest_path is not None
+    m2 = SceneManifest.load(r.manifest_path)
+    (hid,) = [c for c in m2.changes if c.kind == "hidden"]
+    assert hid.old_room != hid.new_room and hid.new_room is not None
+    room = next(q for q in m2.rooms if q.id == hid.new_room)
+    xs, ys = [p[0] for p in room.polygon], [p[1] for p in room.polygon]
+    for T in r.poses:  # the camera never stands in the room left out
+        assert not (min(xs) < T[0, 3] < max(xs) and min(ys) < T[1, 3] < max(ys))
+    shown = [int((f.gt_instance == hid.id).sum()) for f in r]
+    assert sum(shown) == 0 and len(shown) > 50
+    moved = next(c for c in m2.changes if c.kind == "moved")
+    assert any((f.gt_instance == moved.id).any() for f in r)  # a plain move is still seen

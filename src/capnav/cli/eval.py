@@ -53,10 +53,12 @@ def register(app: typer.Typer) -> None:
             help="run the free-phrasing protocol from this JSONL file of hand-written instructions (seed, "
                  "instruction, robot, kind, accept_ids) instead of generated episodes")] = None,
         changes: Annotated[str | None, typer.Option(
-            "--changes", metavar="moved=N,removed=N,added=N",
+            "--changes", metavar="moved=N,removed=N,added=N[,hidden=N]",
             help="the change track instead (docs/change.md): map visit 1, update with visit 2 after these "
-                 "changes, score per change class for capnav (updated map), capnav-static, capnav-remap and "
-                 "capnav-search (visit 1's map and --search, on moved and added objects)")] = None,
+                 "changes, score per change class for capnav (updated map), capnav-static, capnav-remap, "
+                 "capnav-search (visit 1's map and --search, on moved and added objects) and "
+                 "capnav-update-search (the updated map and --search, on hidden objects: carried into a "
+                 "room visit 2 never entered)")] = None,
         per_class: Annotated[int, typer.Option(min=1, help="with --changes: subgoals per change class and "
                                                            "apartment")] = 8,
         reuse_maps: Annotated[bool, typer.Option(

@@ -31,7 +31,8 @@ def register(app: typer.Typer) -> None:
                                   help="1: the apartment as generated; 2 or more: the same apartment after "
                                        "--changes (listed in manifest.json with old and new poses)"),
         changes: str = typer.Option("moved=3,removed=2,added=2", "--changes",
-                                    help="changes of a later --visit: moved=N,removed=N,added=N"),
+                                    help="changes of a later --visit: moved=N,removed=N,added=N,hidden=N "
+                                         "(hidden: carried into a room the visit never enters)"),
         change_seed: int = typer.Option(0, "--change-seed", min=0, help="seed of the changes (default 0)"),
         frame_offset: str | None = typer.Option(
             None, "--frame-offset", metavar="X,Y,YAW",

@@ -9,11 +9,15 @@ then three maps answer the same one-subgoal episodes in the visit-2 world:
 * ``capnav-search``: visit 1's map with ``navigate --search``, on the objects the first map does not
   hold where they are (``moved`` and ``added``): success = reached within 1 m with a driven length
   of at most ``SEARCH_BUDGET`` times the direct path to the object (the walk from the start to the
-  1 m success region plus that metre; the harness judges the length, the search is not told it).
+  1 m success region plus that metre; the harness judges the length, the search is not told it);
+* ``capnav-update-search``: the updated map with ``navigate --search``, on the objects carried into
+  a room visit 2 never entered (``hidden``, with ``--changes ...,hidden=N``): the update saw their
+  old place empty and nothing of their new one, so only a search finds them (same success rule).
 
 Goals are written from the truth the user holds, per change class (protocol ``description/<class>``):
 ``moved`` (described as at visit 2; success = reached at its new place), ``removed`` (described as at
-visit 1; success = "not found"), ``added`` and ``unchanged`` (success = reached). Each description
+visit 1; success = "not found"), ``added`` and ``unchanged`` (success = reached), ``hidden``
+(described as at visit 2, where no frame of visit 2 shows it; success = reached). Each description
 names its object alone in the home it describes (never a bare kind shared by several). Only the harness
 reads the manifests; the maps see frames. The update's CPU time (detection included) is measured
 beside mapping visit 2 from scratch on the same frames.
@@ -40,10 +44,11 @@ from capnav.eval.metrics import SubgoalRecord, summarize_all
 from capnav.sim.changes import ChangeSpec
 from capnav.sim.success import SUCCESS_RADIUS_M
 
-CLASSES = ("moved", "removed", "added", "unchanged")
-METHODS = ("capnav", "capnav-static", "capnav-remap", "capnav-search")
-#: The change classes ``capnav-search`` runs on: objects not in the first map where they are now.
-SEARCH_CLASSES = ("moved", "added")
+CLASSES = ("moved", "removed", "added", "unchanged", "hidden")
+METHODS = ("capnav", "capnav-static", "capnav-remap", "capnav-search", "capnav-update-search")
+#: The change classes each method runs on (the others: every class). ``capnav-search``: objects not in
+#: the first map where they are now; ``capnav-update-search``: objects out of everything visit 2 saw.
+SEARCH_CLASSES = {"capnav-search": ("moved", "added"), "capnav-update-search": ("hidden",)}
 #: Driven length allowed to a search, in direct paths from the start to the object.
 SEARCH_BUDGET = 3.0
 
@@ -94,6 +99,7 @@ def _episodes(scene: int, cfg: ChangeTrackConfig, m1: Any, m2: Any, truth: Scene
     pools = {"moved": [i for i, k in changed.items() if k == "moved"],
              "removed": [i for i, k in changed.items() if k == "removed"],
              "added": [i for i, k in changed.items() if k == "added"],
+             "hidden": [i for i, k in changed.items() if k == "hidden"],
              "unchanged": sorted(o.id for o in m2.objects if o.id not in changed)}
     out: dict[str, list[Episode]] = {}
     for cls, pool in pools.items():
@@ -207,19 +213,20 @@ def run_change_scene(scene: int, cfg: ChangeTrackConfig, out: Path, progress: bo
                                          sight=sight_grid(sim.apartment, nav.spec))
         episodes = _episodes(scene, cfg, man1, man2, truth)
         for name, cmap, frames in (("capnav", mu, r2), ("capnav-static", m1, r1), ("capnav-remap", mr, r2),
-                                   ("capnav-search", m1, r1)):
-            if name not in cfg.methods:
+                                   ("capnav-search", m1, r1), ("capnav-update-search", mu, r2)):
+            classes = SEARCH_CLASSES.get(name, CLASSES)
+            if name not in cfg.methods or not any(episodes.get(c) for c in classes):
                 continue
-            method = create_method(name if name == "capnav-search" else "capnav")
+            method = create_method("capnav-search" if name in SEARCH_CLASSES else "capnav")
             ctx = SceneContext(scene_seed=scene, seed=cfg.seed, sim=sim, embedder=emb, detector=detector(),
                                prior_map=cmap, occupancy=cmap.occupancy, frames=frames, workdir=folder / name)
             for cls, eps in episodes.items():
-                if name == "capnav-search" and cls not in SEARCH_CLASSES:
+                if cls not in classes:
                     continue
                 for ep in eps:
                     for r in run_episode(method, ctx, ep, truth, f"description/{cls}"):
                         r.method = name
-                        if name == "capnav-search":
+                        if name in SEARCH_CLASSES:
                             _within_budget(r, truth.radius)
                         records.append(r)
                         write_json(out / "logs" / name / cls / f"{ep.id}.json",
@@ -253,18 +260,23 @@ def run_change_track(cfg: ChangeTrackConfig, out: Path, progress: bool = True) -
     cpu = {k: round(sum(s["timings"][k] for s in scenes), 3) for k in scenes[0]["timings"]} if scenes else {}
     if cfg.reuse_maps:
         cpu = {}  # maps loaded, not made: the CPU figures are the earlier run's
-    searched = [r for r in recs if r.method == "capnav-search"]
-    search = {"subgoals": len(searched), "budget": f"{SEARCH_BUDGET:g}x the direct path",
-              "within_budget": sum(r.success for r in searched),
-              "reached_any_length": sum(r.success or r.reason.startswith("reached, but drove") for r in searched),
-              "driven_over_direct": [round(r.path_length / (r.shortest_path + SUCCESS_RADIUS_M), 3) for r in searched
-                                     if r.success]}
+    search = _search_figures([r for r in recs if r.method == "capnav-search"])
+    hidden = [r for r in recs if r.method == "capnav-update-search"]
     results = {"track": "change", "changes": str(cfg.changes), "seed": cfg.seed, "scenes": cfg.scene_seeds(),
                "camera": [cfg.width, cfg.height], "detector": f"sim:{cfg.noise}", "summaries": summaries,
-               "search": search,
+               "search": search, **({"update_search": _search_figures(hidden)} if hidden else {}),
                "cpu_seconds": cpu, "per_scene": [{k: v for k, v in s.items() if k != "records"} for s in scenes]}
     write_json(out / "results.json", results)
     return results
+
+
+def _search_figures(searched: list[SubgoalRecord]) -> dict[str, Any]:
+    """How many searches reached their object within the budget, and at any length."""
+    return {"subgoals": len(searched), "budget": f"{SEARCH_BUDGET:g}x the direct path",
+            "within_budget": sum(r.success for r in searched),
+            "reached_any_length": sum(r.success or r.reason.startswith("reached, but drove") for r in searched),
+            "driven_over_direct": [round(r.path_length / (r.shortest_path + SUCCESS_RADIUS_M), 3) for r in searched
+                                   if r.success]}
 
 
 def table(results: dict[str, Any]) -> str:
@@ -277,12 +289,13 @@ def table(results: dict[str, Any]) -> str:
             s = by.get((m, c))
             cells.append("-" if s is None else f"{100 * s['independent']:.1f} ({s['subgoals']})")
         lines.append(f"| {m} | " + " | ".join(cells) + " |")
-    srch = results.get("search") or {}
-    if srch.get("subgoals"):
-        lines.append("")
-        lines.append(f"capnav-search ({', '.join(SEARCH_CLASSES)}): reached within {srch['budget']} "
-                     f"{srch['within_budget']} of {srch['subgoals']}, reached at any length "
-                     f"{srch['reached_any_length']}")
+    for key, name in (("search", "capnav-search"), ("update_search", "capnav-update-search")):
+        srch = results.get(key) or {}
+        if srch.get("subgoals"):
+            lines.append("")
+            lines.append(f"{name} ({', '.join(SEARCH_CLASSES[name])}): reached within {srch['budget']} "
+                         f"{srch['within_budget']} of {srch['subgoals']}, reached at any length "
+                         f"{srch['reached_any_length']}")
     cpu = results.get("cpu_seconds", {})
     if cpu:
         lines.append("")

@@ -1,11 +1,13 @@
 """A later visit to the same apartment: seeded changes (objects moved, removed, new ones placed).
 
 A home changes between two recordings: chairs are pushed around, a plant is carried to another
-room, a lamp is thrown out, an armchair arrives. ``apply_changes`` turns visit 1's apartment
-into visit 2's. Objects keep their manifest ids across visits (the truth an evaluation compares
-against); new objects take ids after the largest one. Every change is listed with its old and
-new pose (``SceneManifest.changes``). The pipeline never reads this list: an update finds the
-changes from the frames alone.
+room, a lamp is thrown out, an armchair arrives, and a visit may not enter every room: a piece
+carried into a room the later recording never enters (``hidden``) is somewhere no frame of that
+visit saw, which only a search finds. ``apply_changes`` turns visit 1's apartment into visit 2's.
+Objects keep their manifest ids across visits (the truth an evaluation compares against); new
+objects take ids after the largest one. Every change is listed with its old and new pose
+(``SceneManifest.changes``). The pipeline never reads this list: an update finds the changes from
+the frames alone.
 """
 
 from __future__ import annotations
@@ -32,16 +34,22 @@ ADDABLE = ("chair", "armchair", "plant", "lamp", "stool", "ottoman", "bookshelf"
 MIN_MOVE = 1.0  # m: a move shorter than this is a nudge, not a change of place
 
 
+#: The kinds of change a ``--changes`` spec counts, in its order.
+KINDS = ("moved", "removed", "added", "hidden")
+
+
 @dataclass(frozen=True)
 class ChangeSpec:
-    """How many objects to move, remove and add (``moved=3,removed=2,added=2``)."""
+    """How many objects to move, remove and add (``moved=3,removed=2,added=2``); ``hidden``: how many
+    to carry into one room that the later visit's recording does not enter (``hidden=1``)."""
 
     moved: int = 0
     removed: int = 0
     added: int = 0
+    hidden: int = 0
 
     def __post_init__(self) -> None:
-        for k in ("moved", "removed", "added"):
+        for k in KINDS:
             v = getattr(self, k)
             if not isinstance(v, int) or v < 0 or v > 50:
                 raise InputError(f"--changes {k} must be an integer in 0..50, got {v!r}")
@@ -53,9 +61,9 @@ class ChangeSpec:
         for item in (s.strip() for s in text.split(",")):
             if not item:
                 continue
-            m = re.fullmatch(r"(moved|removed|added)\s*=\s*(\d+)", item)
-            if m is None:
-                raise InputError(f"--changes: {item!r} is not KIND=COUNT with KIND one of moved, removed, added "
+            m = re.fullmatch(r"(\w+)\s*=\s*(\d+)", item)
+            if m is None or m.group(1) not in KINDS:
+                raise InputError(f"--changes: {item!r} is not KIND=COUNT with KIND one of {', '.join(KINDS)} "
                                  "(e.g. moved=3,removed=2,added=2)")
             if m.group(1) in counts:
                 raise InputError(f"--changes: {m.group(1)} is given twice")
@@ -64,10 +72,11 @@ class ChangeSpec:
 
     @property
     def total(self) -> int:
-        return self.moved + self.removed + self.added
+        return self.moved + self.removed + self.added + self.hidden
 
     def __str__(self) -> str:
-        return f"moved={self.moved},removed={self.removed},added={self.added}"
+        text = f"moved={self.moved},removed={self.removed},added={self.added}"
+        return text + (f",hidden={self.hidden}" if self.hidden else "")  # older specs keep their text
 
 
 def _placed(o: SceneObject) -> Placed:
@@ -121,7 +130,10 @@ def apply_changes(apt: Apartment, spec: ChangeSpec, seed: int, visit: int = 2) -
     items = list(apt.objects)
     changes: list[ObjectChange] = []
     room_of = {k: name for k, name in enumerate(apt.plan.types)}
-    movable = [o for o in items if o.category in MOVABLE]
+    # With hidden objects, one room is left out of the visit: nothing else changes in it or moves into
+    # it (a change there no frame sees); without, the draws are those of every earlier dataset.
+    left_out = _left_out_room(apt, spec.hidden, seed, visit)
+    movable = [o for o in items if o.category in MOVABLE and o.room != left_out]
     if spec.moved + spec.removed > len(movable):
         raise InputError(f"apartment seed {apt.seed} has {len(movable)} movable objects; cannot move "
                          f"{spec.moved} and remove {spec.removed}")
@@ -134,6 +146,7 @@ def apply_changes(apt: Apartment, spec: ChangeSpec, seed: int, visit: int = 2) -
         rooms = [o.room] if rng.random() < 0.5 else [k for k in rng.permutation(len(apt.plan.rooms))]
         if o.room not in rooms:
             rooms.append(o.room)
+        rooms = [k for k in rooms if k != left_out]
         for room in rooms:
             new = _place(apt, items, o, int(room), rng, away_from=(o.x, o.y))
             if new is not None:
@@ -160,6 +173,8 @@ def apply_changes(apt: Apartment, spec: ChangeSpec, seed: int, visit: int = 2) -
         if added == spec.added:
             break
         room = int(rng.integers(len(apt.plan.rooms)))
+        if room == left_out:
+            continue
         cats = [c for c, _, _, _ in ROOM_PLANS[room_of[room]] if c in ADDABLE]
         if not cats:
             continue
@@ -176,7 +191,63 @@ def apply_changes(apt: Apartment, spec: ChangeSpec, seed: int, visit: int = 2) -
         added += 1
     if added < spec.added:
         raise InputError(f"apartment seed {apt.seed}: found free places for {added} of {spec.added} new objects")
+    if spec.hidden:
+        assert left_out is not None
+        items, hidden = _hide(apt, items, spec.hidden, left_out, {c.id for c in changes}, seed, visit)
+        changes += hidden
     items.sort(key=lambda q: q.id)
     out = Apartment(apt.seed, apt.config, apt.plan, items, apt.wall_rects, apt.wall_faces, apt.floor_styles,
                     apt.wall_colors)
     return out, changes
+
+
+def _hide_rng(apt: Apartment, seed: int, visit: int) -> np.random.Generator:
+    """The hidden objects' own random stream: a spec without ``hidden`` draws exactly as before."""
+    return np.random.default_rng([apt.seed, seed, visit, 0xC4B])
+
+
+def _left_out_room(apt: Apartment, hidden: int, seed: int, visit: int) -> int | None:
+    """The room a visit with ``hidden`` objects leaves out: one door (no way between two other rooms
+    passes through it), not the room a recording starts in (the living room); None without hidden."""
+    if not hidden:
+        return None
+    plan = apt.plan
+    start = plan.types.index("living room") if "living room" in plan.types else 0
+    leaves = [k for k in range(len(plan.rooms)) if k != start and sum(k in d.rooms for d in plan.doors) == 1]
+    if not leaves:
+        raise InputError(f"apartment seed {apt.seed} has no room with a single door to leave out of visit "
+                         f"{visit}; cannot hide {hidden} objects there")
+    return int(leaves[int(_hide_rng(apt, seed, visit).integers(len(leaves)))])
+
+
+def _hide(apt: Apartment, items: list[SceneObject], n: int, room: int, changed: set[int], seed: int,
+          visit: int) -> tuple[list[SceneObject], list[ObjectChange]]:
+    """``n`` movable objects carried into ``room``, the one the visit leaves out (kind ``hidden``)."""
+    rng = _hide_rng(apt, seed, visit + 1000)
+    movable = [o for o in items if o.category in MOVABLE and o.id not in changed and o.room != room]
+    out: list[ObjectChange] = []
+    for k in rng.permutation(len(movable)):
+        if len(out) == n:
+            break
+        o = movable[int(k)]
+        new = _place(apt, items, o, room, rng, away_from=(o.x, o.y))
+        if new is None:
+            continue
+        items = [new if q is o else q for q in items]
+        out.append(ObjectChange(kind="hidden", id=o.id, category=o.category, old_pose=_pose(o),
+                                new_pose=_pose(new), old_room=f"room{o.room}", new_room=f"room{room}"))
+    if len(out) < n:
+        raise InputError(f"apartment seed {apt.seed}: found free places for {len(out)} of {n} hidden objects "
+                         f"in room{room}")
+    return items, out
+
+
+def left_out_rooms(changes: list[ObjectChange]) -> set[int]:
+    """The rooms a visit's recording does not enter: where its ``hidden`` objects were carried."""
+    return {int(c.new_room.removeprefix("room")) for c in changes if c.kind == "hidden" and c.new_room}
+
+
+def hidden_ids(changes: list[ObjectChange]) -> set[int]:
+    """The objects a visit's recording must never show (a frame looking at one through the door of
+    the room it was left in is not recorded)."""
+    return {c.id for c in changes if c.kind == "hidden"}

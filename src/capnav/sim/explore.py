@@ -37,6 +37,7 @@ class ExploreConfig:
     stride: int = 1  # keep every stride-th frame
     max_frames: int | None = None  # subsample uniformly to at most this many frames
     min_frames: int = 200  # small flats get more viewpoints (extra distances and spots) up to this
+    skip_rooms: tuple[int, ...] = ()  # rooms this pass leaves out (a later visit that never enters them)
 
     def __post_init__(self) -> None:
         if self.stride < 1:
@@ -70,7 +71,7 @@ def _plan(sim: Simulator, cfg: ExploreConfig) -> list[NDArray[np.float64]]:
     pts = grid.free_points()
     apt = sim.apartment
     cam_h = sim.config.agent.camera_height
-    order = _room_order(sim)
+    order = [k for k in _room_order(sim) if k not in cfg.skip_rooms]
     sight = sight_grid(apt, grid.spec)  # walls and tall furniture: a view of an object must see it
     poses: list[NDArray[np.float64]] = []
     pos: NDArray[np.float64] | None = None

@@ -60,7 +60,8 @@ class ItemInstance(BaseModel):
 class ObjectChange(BaseModel):
     """One change between visit 1 and a later visit; poses are (x, y, yaw) in the apartment frame."""
 
-    kind: str = Field(description="moved | removed | added")
+    kind: str = Field(description="moved | removed | added | hidden (moved into a room the visit's "
+                      "recording does not enter)")
     id: int = Field(ge=1, description="manifest id (the same object keeps its id across visits)")
     category: str
     old_pose: Vec3 | None = None

@@ -30,6 +30,12 @@ def planar_pose(x: float, y: float, yaw: float) -> NDArray[np.float64]:
     return T
 
 
+def _shows(sim: Simulator, T: NDArray[np.float64], ids: NDArray[np.int32]) -> bool:
+    """Whether the view from ``T`` shows any pixel of the objects ``ids``."""
+    gt = sim.render(T, index=0).gt_instance
+    return gt is not None and bool(np.isin(gt, ids).any())
+
+
 def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride: int = 1, width: int = 320,
                    height: int = 240, hfov: float = 90.0, rooms: int | None = None, furniture: str = "primitives",
                    depth_noise: bool = False, overwrite: bool = False, progress: bool = True,
@@ -74,7 +80,13 @@ def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride
     t0 = time.perf_counter()
     with Simulator.from_seed(seed, cfg, visit=visit, changes=changes, change_seed=change_seed) as sim:
         t_build = time.perf_counter() - t0
-        poses = plan_exploration(sim, ExploreConfig(seed=seed, stride=stride, max_frames=frames))
+        from capnav.sim.changes import hidden_ids, left_out_rooms
+
+        poses = plan_exploration(sim, ExploreConfig(seed=seed, stride=stride, max_frames=frames,
+                                                    skip_rooms=tuple(sorted(left_out_rooms(sim.manifest.changes)))))
+        hide = np.asarray(sorted(hidden_ids(sim.manifest.changes)), dtype=np.int32)
+        if hide.size:  # a visit that never entered their room: the views into it through its door are dropped
+            poses = [T for T in poses if not _shows(sim, T, hide)]
         meta = {"source": "capnav.sim", "seed": seed, "furniture": furniture, "rooms": len(sim.manifest.rooms),
                 "objects": len(sim.manifest.objects), "depth_noise": depth_noise, "exploration": "capnav.sim.explore"}
         if sim.manifest.items:  # only then: default datasets keep their meta.json bytes
