@@ -60,6 +60,9 @@ REQUESTS: dict[str, list[tuple[str, str | None, str]]] = {
     ],
 }
 
+#: Requests that name one of two objects of a label, and the side of the image it stands on.
+SIDE = {"the yellow chair": "right", "the red office chair": "left"}
+
 
 def write_recording(enc: str, out: Path) -> None:
     """One frame, identity pose, PrimeSense intrinsics (the folder's README), TUM layout."""
@@ -114,9 +117,12 @@ def main() -> None:
                     res = json.loads(r.stdout)
                 except json.JSONDecodeError:
                     res = {"found": False, "error": (r.stdout + r.stderr)[-300:]}
-                got = res.get("label") if res.get("found") else None
-                reason = str(res.get("reason", ""))
+                chosen = res.get("chosen") if res.get("found") else None
+                got = chosen.get("label") if chosen else None
+                reason = str(res.get("reason", res.get("error", "")))
                 ok = got == want
+                if ok and chosen and req in SIDE:  # which of two: left or right of the camera (x)
+                    ok = (chosen["position"][0] > 0) == (SIDE[req] == "right")
                 if want is None and why == "class":
                     ok = ok and "no such class" in reason
                 nav = ""
