@@ -33,7 +33,7 @@ REQUESTS: dict[str, list[tuple[str, str | None, str]]] = {
         ("the seat", "chair", ""),
         ("the bottle on the table", "bottle", ""),
         ("the bottle", "bottle", ""),
-        ("the desk", "dining table", ""),
+        ("the desk", "table", ""),
         ("the cup", "cup", ""),
         ("the sofa", None, "none"),
         ("the toilet", None, "none"),
@@ -44,7 +44,7 @@ REQUESTS: dict[str, list[tuple[str, str | None, str]]] = {
     # with a wooden table and two chairs.
     "nyu": [
         ("the chair", "chair", ""),
-        ("the table", "dining table", ""),
+        ("the table", "table", ""),
         ("the seat", "chair", ""),
         ("the cabinet", None, "class"),
         ("the wardrobe", None, "class"),
@@ -124,14 +124,17 @@ def main() -> None:
                 if ok and chosen and req in SIDE:  # which of two: left or right of the camera (x)
                     ok = (chosen["position"][0] > 0) == (SIDE[req] == "right")
                 if want is None and why == "class":
-                    ok = ok and "no such class" in reason
+                    ok = ok and "has no" in reason.split(" Other candidates:")[0] and "class" in reason
                 nav = ""
                 if got is not None:
-                    n = cli("navigate", str(mp), req, "-o", str(a.out / f"nav-{enc}-{det}"), "--json")
+                    nav_dir = a.out / f"nav-{enc}-{det}"
+                    n = cli("navigate", str(mp), req, "-o", str(nav_dir))
                     try:
-                        nj = json.loads(n.stdout)
-                        nav = f"ok={nj.get('ok')} seen_free={nj.get('seen_free_fraction')} {nj.get('reason', '')}"
-                    except json.JSONDecodeError:
+                        nj = json.loads((nav_dir / "navigate.json").read_text())
+                        nav = (f"ok={nj.get('ok')} seen_free={nj.get('seen_free_fraction')} "
+                               f"{str(nj.get('reason', ''))[:70]}")
+                        (nav_dir / "navigate.json").unlink()
+                    except (OSError, json.JSONDecodeError):
                         nav = (n.stdout + n.stderr)[-200:].replace("\n", " ")
                 rows.append((enc, det, req, want, got, reason[:90], ok, nav))
                 print(f"{enc:4} {det:13} {req!r:32} want={want!s:13} got={got!s:13} {'OK ' if ok else 'BAD'} "

@@ -41,3 +41,27 @@ def test_long_recording_keeps_h_min(tmp_path: Path) -> None:
     r = CliRunner().invoke(app, ["map", str(ds), "-o", str(out), "--noise", "oracle", "--no-progress"])
     assert r.exit_code == 0, r.output
     assert load_map(out).meta["h_min_used"] == 3
+
+
+def test_the_grid_covers_the_cameras_that_saw_it() -> None:
+    """A camera looking ahead never sees the floor under it (the real NYU frame's floor starts
+    0.85 m ahead): the grid still covers it, so the camera's pose can be a start (on unknown
+    floor, said as such by the planner) instead of "start (0.00, 0.00) is off the map"."""
+    import numpy as np
+
+    from capnav.core.grid import UNKNOWN
+    from capnav.mapping.occupancy import occupancy_from_voxels
+    from capnav.mapping.voxel_map import VoxelMap
+
+    vm = VoxelMap(0.05, feature_dim=1)
+    xs, ys = np.meshgrid(np.arange(-1.0, 1.0, 0.05), np.arange(0.85, 3.0, 0.05))
+    pts = np.stack([xs.ravel(), ys.ravel(), np.full(xs.size, 0.01)], axis=1)
+    vm.integrate(pts, np.ones(len(pts)), np.zeros((len(pts), 3), np.uint8), np.zeros(len(pts), int),
+                 np.zeros((1, 1), np.float32))
+    eye = np.array([[0.0, 0.0]])
+    occ = occupancy_from_voxels(vm, cover=eye)
+    rc = occ.spec.to_cell(eye)
+    assert occ.spec.inside(rc).all()
+    assert occ.cells[rc[0, 0], rc[0, 1]] == UNKNOWN  # covered, not claimed free
+    plain = occupancy_from_voxels(vm)
+    assert abs((occ.spec.x0 - plain.spec.x0) / 0.05 - round((occ.spec.x0 - plain.spec.x0) / 0.05)) < 1e-6

@@ -32,7 +32,7 @@ def _render(box_lo: np.ndarray, box_hi: np.ndarray) -> tuple[np.ndarray, np.ndar
     ray_c = np.stack([(u - K.cx) / K.fx, (v - K.cy) / K.fy, np.ones_like(u)], axis=-1)  # depth = t
     ray = ray_c @ T[:3, :3].T
     e = T[:3, 3]
-    t = np.full(u.shape + (3,), np.inf)
+    t = np.full((*u.shape, 3), np.inf)
     with np.errstate(divide="ignore", invalid="ignore"):
         tt = (TOP - e[2]) / ray[..., 2]
         p = e + tt[..., None] * ray
