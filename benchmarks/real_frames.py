@@ -131,8 +131,9 @@ def main() -> None:
                     n = cli("navigate", str(mp), req, "-o", str(nav_dir))
                     try:
                         nj = json.loads((nav_dir / "navigate.json").read_text())
-                        nav = (f"ok={nj.get('ok')} seen_free={nj.get('seen_free_fraction')} "
-                               f"{str(nj.get('reason', ''))[:70]}")
+                        g, pth = nj.get("goal") or {}, nj.get("path") or {}
+                        nav = (f"ok={nj.get('ok')} goal_on_seen_floor={g.get('on_seen_floor')} "
+                               f"path_seen_free={pth.get('seen_free_fraction')} {str(nj.get('reason', ''))[:60]}")
                         (nav_dir / "navigate.json").unlink()
                     except (OSError, json.JSONDecodeError):
                         nav = (n.stdout + n.stderr)[-200:].replace("\n", " ")
