@@ -65,3 +65,20 @@ def test_the_grid_covers_the_cameras_that_saw_it() -> None:
     assert occ.cells[rc[0, 0], rc[0, 1]] == UNKNOWN  # covered, not claimed free
     plain = occupancy_from_voxels(vm)
     assert abs((occ.spec.x0 - plain.spec.x0) / 0.05 - round((occ.spec.x0 - plain.spec.x0) / 0.05)) < 1e-6
+
+
+def test_an_empty_map_is_refused_as_empty_not_as_uncaptioned(tmp_path: Path) -> None:
+    """A one-frame map whose detector kept nothing: `capnav query` said "has no captions/embeddings:
+    run `capnav caption` first" although caption had run; the reason is that the map is empty."""
+    from capnav.core.errors import InputError
+    from capnav.io.mapfile import save_map
+    from capnav.mapping.cmap import CapNavMap
+    from capnav.mapping.occupancy import occupancy_from_voxels
+    from capnav.mapping.voxel_map import VoxelMap
+
+    vm = VoxelMap(0.05, feature_dim=1)
+    out = tmp_path / "empty.capnav"
+    save_map(CapNavMap(objects=[], voxels=vm, occupancy=occupancy_from_voxels(vm), meta={}), out)
+    r = CliRunner().invoke(app, ["query", str(out), "the chair", "--json"])
+    assert isinstance(r.exception, InputError), r.output
+    assert "has no objects" in str(r.exception) and "caption" not in str(r.exception)
