@@ -112,6 +112,22 @@ def test_a_category_the_detector_cannot_output_is_not_found_for_that_reason(emb)
     assert not res.found and "detector" not in res.reason
 
 
+def test_a_category_without_a_class_is_refused_for_that_reason_among_small_things(emb):
+    # A desk's things (a bottle, a book, a chair) and no stand-in of the asked category: every
+    # object is compared, but none can be a cabinet or a lamp, which the detector has no class for
+    # (before, the reason was only "the best candidate, object 2 (book), was rejected").
+    r = _retriever(emb, [make_obj(1, "chair", (1.0, 1.0), (0.5, 0.5, 0.9), (120, 30, 60)),
+                         make_obj(2, "book", (2.0, 1.2), (0.2, 0.05, 0.3), (230, 180, 40)),
+                         make_obj(3, "bottle", (2.4, 1.2), (0.08, 0.08, 0.3), (60, 160, 90))], COCO_LIKE)
+    for text in ("the cabinet", "the lamp by the chair", "the tall lamp"):
+        res = r.query(text)
+        assert not res.found, (text, res.reason)
+        why = res.reason.split(" Other candidates:")[0].split(" Notes:")[0]  # the answer's own reason, not a note
+        assert "has no" in why and "class" in why and "detector" in why and "rejected" not in why, (text, res.reason)
+    res = r.query("the sofa")  # a class it has, absent: plain absence
+    assert not res.found and "detector" not in res.reason
+
+
 def test_without_a_recorded_vocabulary_absence_is_plain(emb):
     r = _retriever(emb, [make_obj(1, "chair", (1.0, 1.0), (0.5, 0.5, 0.9), (120, 80, 40))])
     res = r.query("the wardrobe")

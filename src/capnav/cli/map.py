@@ -100,6 +100,13 @@ def register(app: typer.Typer) -> None:
         speed = f" ({m['frames_used'] / seconds:.1f} frames/s)" if seconds > 0 and m["frames_used"] else ""
         con.print(f"{output}: {len(cmap.objects)} objects, {len(cmap.voxels)} voxels, "
                   f"{m['frames_used']} frames{speed}, detector {det.id}")
+        default_h_min = cfg.tracker.h_min
+        if m.get("h_min_used", default_h_min) < default_h_min:
+            n_used = m["h_min_used"]
+            con.print(f"note: a recording of {n_used} frame{'s' if n_used > 1 else ''}: an object is kept when seen in "
+                      f"{n_used} frame{'s' if n_used > 1 else ''} (h_min {default_h_min} asks for more sightings "
+                      "than there are frames); single detections are not confirmed by a second view",
+                      highlight=False)
         for reason, frames in _grouped(m["frames_skipped"]):
             con.print(f"[yellow]skipped {_frames(frames)}:[/] {reason}", highlight=False)
         for err in m.get("detector_errors", []):

@@ -66,6 +66,9 @@ def register(app: typer.Typer) -> None:
             from capnav.mapping.embeddings import check_embeddings
 
             check_embeddings(cmap, str(map_path))  # all-zero or non-unit vectors: refused, not answered 0.000
+            if not cmap.objects:  # not "no captions": captioning an empty map leaves it empty
+                raise InputError(f"{map_path} has no objects, so nothing can be found in it (`capnav map` said "
+                                 "why when it wrote the map: e.g. nothing detected, or too few frames)")
             if embedder == "auto":
                 models = {o.embedding_model for o in cmap.objects if o.embedding_model}
                 if not models:

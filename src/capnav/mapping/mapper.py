@@ -203,7 +203,8 @@ class Mapper:
             self.carved_points = self.memory.carve(self.views)
         merged = self.memory.merge_duplicates()
         objects = self.memory.export()
-        occ = occupancy_from_voxels(self.voxels, self.config.occupancy)
+        eyes = np.array([T[:2, 3] for _, T in self.camera_path]).reshape(-1, 2)
+        occ = occupancy_from_voxels(self.voxels, self.config.occupancy, cover=eyes)
         jumps = self.pose_jumps()
         if jumps.jumps:
             log.warning(jumps.message())

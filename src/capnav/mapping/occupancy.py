@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from capnav.core.errors import InputError
 from capnav.core.grid import FREE, OCCUPIED, UNKNOWN, GridSpec, OccupancyGrid
@@ -36,8 +37,10 @@ class OccupancyConfig:
 
 
 def occupancy_from_voxels(voxels: VoxelMap, config: OccupancyConfig | None = None,
-                          spec: GridSpec | None = None) -> OccupancyGrid:
-    """Build the FREE / OCCUPIED / UNKNOWN grid; ``spec`` defaults to the voxels' extent + margin."""
+                          spec: GridSpec | None = None, cover: NDArray[np.floating] | None = None) -> OccupancyGrid:
+    """Build the FREE / OCCUPIED / UNKNOWN grid; ``spec`` defaults to the voxels' extent + margin,
+    grown to hold the (N, 2) points ``cover`` too (the cameras: a camera looking ahead never sees
+    the floor it stands on, and a one-frame map would otherwise put its own start off the map)."""
     cfg = config or OccupancyConfig()
     c = voxels.centers()
     keep = voxels.weights >= cfg.min_weight
@@ -50,6 +53,12 @@ def occupancy_from_voxels(voxels: VoxelMap, config: OccupancyConfig | None = Non
             # on a cell boundary falls either way under round-off and leaves stripes of UNKNOWN cells.
             h = voxels.resolution / 2.0
             lo, hi = c[:, :2].min(axis=0) - h, c[:, :2].max(axis=0) + h
+            if cover is not None and len(cover):
+                # grown by whole voxels, so that the grid lines stay on voxel faces
+                q = np.asarray(cover, dtype=np.float64)[:, :2]
+                r = voxels.resolution
+                lo = lo - np.ceil(np.maximum(lo - q.min(axis=0), 0.0) / r) * r
+                hi = hi + np.ceil(np.maximum(q.max(axis=0) - hi, 0.0) / r) * r
             spec = GridSpec.covering(float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]), cfg.resolution,
                                      cfg.margin)
     cells = np.full((spec.rows, spec.cols), UNKNOWN, dtype=np.uint8)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import Any
 
@@ -23,8 +24,13 @@ def map_dataset(path: str | Path | DatasetReader, detector: Detector, encoder: D
     path = reader.path
     if detector.needs_truth and not reader.has_gt:
         raise needs_truth_error(detector, str(path))
-    mapper = Mapper(config, detector, encoder)
     n = len(reader) if max_frames is None else min(len(reader), max_frames)
+    cfg = config or MapperConfig()
+    if 0 < n < cfg.tracker.h_min:
+        # A recording of n frames shows an object at most n times: asking for more sightings than
+        # there are frames would drop every object of a short (e.g. one-frame) recording.
+        cfg = dataclasses.replace(cfg, tracker=dataclasses.replace(cfg.tracker, h_min=n))
+    mapper = Mapper(cfg, detector, encoder)
     for i in track(range(n), "mapping", total=n, enabled=progress):
         try:
             frame = reader.frame(i)
@@ -36,7 +42,7 @@ def map_dataset(path: str | Path | DatasetReader, detector: Detector, encoder: D
         mapper.integrate(frame)
     # What the map was made from, so caption / map-eval / navigate can refuse another apartment's data.
     meta: dict[str, Any] = {"dataset": str(Path(path).resolve()), "dataset_frames": len(reader),
-                            "dataset_id": reader.fingerprint()}
+                            "dataset_id": reader.fingerprint(), "h_min_used": cfg.tracker.h_min}
     producer = reader.meta.get("meta") or {}
     if producer.get("source") == "capnav.sim" and isinstance(producer.get("seed"), int):
         meta["scene_seed"] = producer["seed"]  # lets `capnav navigate` drive in the same apartment

@@ -138,9 +138,13 @@ def cut_at_support(mask: NDArray[np.bool_], depth: NDArray[np.floating], K: Intr
     up = up_facing_pixels(d, Kc, T_wc, cfg.step, cfg.up_cos)
     z = P[..., 2]
     zp = support_plane(z[m], up[m], cfg, highest=not thing)
+    tol = cfg.tol + cfg.tol_quad * d**2
+    flat = _only_support(m, z, d, box[3] - box[1], K.fy, tol, cfg) if thing else None
+    if flat is not None:
+        own = _thing_over_support(ok, z, d, flat, tol, cfg)
+        return own if own is not None else mask
     if zp is None:
         return mask
-    tol = cfg.tol + cfg.tol_quad * d**2
     above = m & (z > zp + tol)
     apart = above & ~depth_jumps(d, ok)  # two bowls side by side in the image are two parts
     if thing:  # the largest connected part above the plane: the thing the box was drawn around
@@ -180,6 +184,54 @@ def cut_at_support(mask: NDArray[np.bool_], depth: NDArray[np.floating], K: Intr
             continue  # not over the plane: beside it
         out[sl] &= ~part
     return out
+
+
+def _only_support(m: NDArray[np.bool_], z: NDArray[np.float64], d: NDArray[np.float64], box_rows: float,
+                  fy: float, tol: NDArray[np.float64], cfg: SupportCutConfig) -> float | None:
+    """The height of the flat surface a thing's mask holds instead of the thing, or None. The
+    box mask took the table top the thing stands on (it fills the box's foot, and a thin or
+    see-through bottle gives few depth pixels of its own): its points span a sliver of height
+    (within a few depth tolerances) where the box, at their depth, is many times as tall. Normals
+    are not asked: at 2-3 m a Kinect's depth steps make a table top's normals noisy."""
+    n = int(m.sum())
+    if n < cfg.min_plane_points:
+        return None
+    zm = z[m]
+    lo, zp, hi = (float(v) for v in np.percentile(zm, [5, 50, 95]))
+    tall = box_rows * float(np.median(d[m])) / fy  # the box's height in metres at the mask's depth
+    if zp < cfg.min_height or hi - lo > max(3 * float(np.median(tol[m])), 0.15 * tall):
+        return None
+    return zp
+
+
+def _thing_over_support(ok: NDArray[np.bool_], z: NDArray[np.float64], d: NDArray[np.float64], zp: float,
+                        tol: NDArray[np.float64], cfg: SupportCutConfig) -> NDArray[np.bool_] | None:
+    """The thing in the box (the whole crop) standing on the plane at height ``zp``: the largest
+    part above it, apart at depth jumps, that rises from the plane (its lowest points within a
+    few tolerances of it) and does not run across the box from side to side (the wall or panel
+    behind the table does); None when there is no such part (a magazine lying flat is its own
+    flat mask)."""
+    above = ok & (z > zp + 2 * tol)
+    lab, n = ndimage.label(above & ~depth_jumps(d, ok), structure=_EIGHT)
+    if n == 0:
+        return None
+    w = lab.shape[1]
+    best, best_n = 0, cfg.min_part - 1
+    for k, sl in enumerate(ndimage.find_objects(lab), start=1):
+        if sl is None:
+            continue
+        part = lab[sl] == k
+        size = int(part.sum())
+        if size <= best_n or (sl[1].start <= 1 and sl[1].stop >= w - 1):
+            continue  # smaller than the best, or runs across the box: background
+        if float(z[sl][part].min()) > zp + 4 * float(np.median(tol[sl][part])) + 2 * cfg.bin:
+            continue  # floats above the plane: something behind, not standing on it
+        best, best_n = k, size
+    if best == 0:
+        return None
+    own = lab == best
+    grow = above & (lab == 0) & (d <= float(d[own].max()) + tol)  # its outline, not the far side of it
+    return np.asarray(ndimage.binary_propagation(lab == best, structure=_EIGHT, mask=own | grow))
 
 
 def stands_on(top: NDArray[np.floating], base: NDArray[np.floating], radius: float = 0.06, rise: float = 0.02,

@@ -48,7 +48,13 @@ class Detectable(RankingConstraint):
         det = str(r.cmap.meta.get("detector", "the detector")).split(":")[0]
         why = (f"the map's detector ({det}) has no '{q.category}' class, so the map cannot contain "
                f"{'an' if q.category[:1] in 'aeiou' else 'a'} {q.category}")
-        if st.refusal is not None or not len(st.pool) or not (st.weights[st.pool] > 0).any():
+        # Refused unless a stand-in the request admits is in the map (a table for "the desk"): with
+        # none, every object was pooled only to be compared, and none of them can be the category
+        # the detector has no class for.
+        from capnav.retrieval.constraints.category import Category
+
+        named = Category.weights(st)
+        if st.refusal is not None or not len(st.pool) or not (named[st.pool] > 0).any():
             st.refuse(self.kind, why)
         else:
             st.notes.append(why)
