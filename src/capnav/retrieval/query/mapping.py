@@ -373,7 +373,10 @@ def _negations(q: ParsedQuery, head: str) -> str:
             continue
         cat, span, _ = _find_category(words)
         before = _find_category(out[: m.start()].split())[0]
-        if cat is not None and before is not None and before != cat:
+        # The wanted one may be said after the negation ("not the desk, the cabinet by the wall",
+        # "not either of the desks but the cabinet"): another category there names the target too.
+        after = _find_category(_after_negation(out[m.end():]).split())[0]
+        if cat is not None and ((before is not None and before != cat) or (after is not None and after != cat)):
             # "the sink, not the bathtub": another kind than the one asked for is excluded whole.
             out = out[: m.start()] + " " + out[m.end():]
             q.negations.append(" ".join(w for w in words if w not in _DETERMINERS))
@@ -391,6 +394,53 @@ def _negations(q: ParsedQuery, head: str) -> str:
                 q.negations.append(" ".join(part))
     out = re.sub(r"\bthe\s+other\s+(?:one|of\s+the\s+two)\b", " ", out)
     return " ".join(out.split())
+
+
+#: Words that say a part follows: "the dresser with the glass top", "a stool that has a leather seat".
+_HAVING = {"with", "has", "having", "have"}
+_PART_DETERMINERS = {"a", "an", "the", "its", "their", "some", "two", "three", "four"}
+
+
+def _without_parts(q: ParsedQuery, words: list[str]) -> list[str]:
+    """``words`` without the materials said of a part ("the dresser with the glass top": glass is
+    the top's), which go to ``q.part_materials`` with a note: the map observes an object's surface
+    as a whole, not its parts apart, so a part's material is neither for nor against it. A part is
+    the first word after "with" / "has" and its modifiers that no table of the lexicon holds (not
+    a category, colour, material, size or shape word): "the table with glass" keeps its glass."""
+    out = list(words)
+    for k, w in enumerate(words):
+        if w not in _HAVING:
+            continue
+        j = k + 1
+        while j < len(words) and words[j] in _PART_DETERMINERS:
+            j += 1
+        mods = j
+        while j < len(words) and (material_of(words[j]) is not None or words[j] in LEXICON or words[j] in ALIASES
+                                  or words[j] in _SHAPES or words[j] in _SIZE_TOKENS):
+            j += 1
+        if j == mods or j >= len(words):
+            continue
+        part = words[j]
+        if not part.isalpha() or part in _FILLER or part in _HAVING or _find_category([part])[0] is not None:
+            continue
+        mats = materials_in(words[mods:j])
+        if not mats:
+            continue
+        q.part_materials.setdefault(part, []).extend(m for m in mats if m not in q.part_materials.get(part, []))
+        q.notes.append(f"{'/'.join(mats)} is said of its {part}, which the map does not observe apart "
+                       f"(neither for nor against it)")
+        for i in range(mods, j):
+            if material_of(words[i]) is not None:
+                out[i] = ""
+    return [w for w in out if w]
+
+
+def _after_negation(rest: str) -> str:
+    """The words after a negated phrase up to the next negation: those of the phrase that says
+    which one is meant ("..., the cabinet by the wall"; "... but the cabinet")."""
+    rest = re.sub(r"^\s*(?:[,;]|\bbut\b)\s*", " ", rest)
+    nxt = _NEGATION.search(rest)
+    return rest[: nxt.start()] if nxt is not None else rest
 
 
 _FROM_ROBOT = "the robot"
@@ -568,7 +618,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     q.shapes = _shapes(words)
     if "l-shaped" in head or "l shaped" in head:
         q.shapes = list(dict.fromkeys([*q.shapes, "L-shaped"]))
-    q.materials = materials_in(words)
+    q.materials = materials_in(_without_parts(q, words))
     cat, span, fuzzy = _find_category(words)
     other = _other_object(words, span) if cat in BY_NAME else None  # a class's own compound names it
     if other is not None:
