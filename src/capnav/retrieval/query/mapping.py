@@ -309,13 +309,24 @@ def _passed_objects(q: ParsedQuery, head: str) -> str:
 
 def _shapes(words: list[str]) -> list[str]:
     """The shapes ``words`` name, once each. "Corner" is a shape only right before an object's
-    name ("the corner sofa"); "in the corner" says where a thing stands."""
+    name ("the corner sofa"); "in the corner" says where a thing stands. A shape word before a
+    word of direction says how to go ("straight to", "round the back")."""
     def names_object_at(i: int) -> bool:
         span = _find_category(words[i:i + 2])[1]
         return span is not None and span[0] == 0
 
+    def of_the_motion(i: int) -> bool:
+        # "go straight to the sofa", "head straight ahead", "come round the back": a shape word
+        # before a preposition, an adverb of direction or a determiner says how to go, not a shape.
+        return i + 1 < len(words) and words[i + 1] in _MOTION_NEXT
+
     return list(dict.fromkeys(_SHAPES[w] for i, w in enumerate(words)
-                              if w in _SHAPES and (w != "corner" or names_object_at(i + 1))))
+                              if w in _SHAPES and (w != "corner" or names_object_at(i + 1)) and not of_the_motion(i)))
+
+
+_MOTION_NEXT = {"to", "towards", "toward", "for", "ahead", "on", "onto", "through", "into", "over", "across",
+                "past", "back", "down", "up", "away", "at", "there", "here", "along", "the", "a", "an", "my",
+                "your", "our", "this"}
 
 
 def relation_name(rel: str) -> str:
@@ -396,6 +407,33 @@ def _negations(q: ParsedQuery, head: str) -> str:
     return " ".join(out.split())
 
 
+def _joined_compounds(words: list[str]) -> list[str]:
+    """A verb and its particle said apart that the lexicon knows as one hyphenated attribute ("a
+    table you can see through", "see right through": WordNet's "see-through", glass): the two
+    words become that form; an adverb between them ("right", "straight", "clean") goes with them.
+    Words that say something alone are read alone ("light blue" stays a light blue, not the
+    lexicon's "light-blue"), and a determiner, a conjunction, a preposition ("see into through
+    the top": through the top is a part) or an object word between them is another phrase."""
+    out = list(words)
+    k = 0
+    while k < len(out) - 1:
+        for gap in (1, 2):
+            if k + gap >= len(out):
+                break
+            form = f"{out[k]}-{out[k + gap]}"
+            said = any(w in LEXICON or w in ALIASES or w in _COLOUR_OF or w in _SHAPES or material_of(w) is not None
+                       or _find_category([w])[0] is not None for w in out[k:k + gap + 1])
+            apart = any(w in _DETERMINERS or w in _FILLER or w in _PREPOSITIONS for w in out[k + 1:k + gap])
+            if form in _LEX.attributes and not said and not apart:
+                out[k:k + gap + 1] = [form]
+                break
+        k += 1
+    return out
+
+
+_PREPOSITIONS = _MOTION_NEXT | {"in", "out", "under", "off", "from", "of", "by", "with", "behind", "inside"}
+
+
 #: Words that say a part follows: "the dresser with the glass top", "a stool that has a leather seat".
 _HAVING = {"with", "has", "having", "have"}
 _PART_DETERMINERS = {"a", "an", "the", "its", "their", "some", "two", "three", "four"}
@@ -406,7 +444,9 @@ def _without_parts(q: ParsedQuery, words: list[str]) -> list[str]:
     the top's), which go to ``q.part_materials`` with a note: the map observes an object's surface
     as a whole, not its parts apart, so a part's material is neither for nor against it. A part is
     the first word after "with" / "has" and its modifiers that no table of the lexicon holds (not
-    a category, colour, material, size or shape word): "the table with glass" keeps its glass."""
+    a category, colour, material, size or shape word) and no noun of how the whole looks or feels
+    ("the sofa with the velvety feel", "a walnut finish": the lexicon's ``surface_nouns``): "the
+    table with glass" keeps its glass."""
     out = list(words)
     for k, w in enumerate(words):
         if w not in _HAVING:
@@ -421,7 +461,8 @@ def _without_parts(q: ParsedQuery, words: list[str]) -> list[str]:
         if j == mods or j >= len(words):
             continue
         part = words[j]
-        if not part.isalpha() or part in _FILLER or part in _HAVING or _find_category([part])[0] is not None:
+        if not part.isalpha() or part in _FILLER or part in _HAVING or part in _LEX.surface_nouns \
+                or _find_category([part])[0] is not None:
             continue
         mats = materials_in(words[mods:j])
         if not mats:
@@ -603,7 +644,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                     q.anchor_phrase = m.group(1)
                     head = head[:m.start()]
                     break
-    words = [w for w in re.split(r"\s+", head.strip()) if w]
+    words = _joined_compounds([w for w in re.split(r"\s+", head.strip()) if w])
     for phrase in sorted(_SUPERLATIVE, key=len, reverse=True):
         if phrase in head and re.search(rf"\b{phrase}\b", head):
             q.superlative, q.size_axis = _SUPERLATIVE[phrase], size_axis(phrase)
@@ -620,6 +661,11 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
         q.shapes = list(dict.fromkeys([*q.shapes, "L-shaped"]))
     q.materials = materials_in(_without_parts(q, words))
     cat, span, fuzzy = _find_category(words)
+    # A word that is a material only as a noun ("plush": lavish as an adjective) is one when said
+    # after the target's noun ("the armchair covered in soft plush"), not before it.
+    said_after = [w for w in words[span[1]:] if w in _LEX.material_nouns and material_of(w) is None] \
+        if span is not None else []
+    q.materials = list(dict.fromkeys([*q.materials, *(_LEX.material_nouns[w] for w in said_after)]))
     other = _other_object(words, span) if cat in BY_NAME else None  # a class's own compound names it
     if other is not None:
         # "pool table", "power plant": WordNet names another object ending in a category word.
@@ -637,7 +683,8 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
              | set(_MATERIAL_OF) | _COMMON_ADJECTIVES | {w for c in q.colors for w in c.split()}
              | (_GROWTH_TOKENS if cat == "plant" else set())
              | {w for w in words if re.fullmatch(r"[a-z]+-colou?red", w) or material_of(w)}
-             | set(UNOBSERVED) | {w for w in words if w in _COLOUR_OF and _COLOUR_OF[w] in q.colors})
+             | set(UNOBSERVED) | {w for w in words if w in _COLOUR_OF and _COLOUR_OF[w] in q.colors}
+             | set(said_after))
     for w in dict.fromkeys(w for w in words if w in UNOBSERVED):
         # "the squishy armchair": WordNet's soft; no map observes it, so it neither confirms nor refuses.
         q.notes.append(f"'{w}' says {UNOBSERVED[w]}, which the map does not observe")
