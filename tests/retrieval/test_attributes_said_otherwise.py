@@ -39,9 +39,9 @@ def _slab(center: tuple[float, float], w: float, d: float, h: float, seed: int =
 
 @pytest.fixture(scope="module")
 def lounge(emb) -> Retriever:
-    """Two ottomans (a grainy leather one, a plain velvet one), a woven and a plain dresser, two
-    dark stools (woven, grainy), a glass side table and a wooden one (both 'table'), two desks and
-    a cabinet, a round and a long bench."""
+    """Two ottomans (a grainy leather one, a plain velvet one), a dresser (its crop reads woven),
+    two grey stools (woven, grainy), a glass side table and a wooden one (both 'table'), two desks
+    and a cabinet, a round and a long bench."""
     tan, teal, grey = (150, 100, 70), (40, 110, 120), (110, 110, 115)
     objs = [
         textured_view(make_obj(1, "ottoman", (1.0, 1.0), (0.7, 0.7, 0.45), tan, shading=(1.0, 1.0)), "leather"),
@@ -50,7 +50,7 @@ def lounge(emb) -> Retriever:
         textured_view(make_obj(4, "table", (1.0, 4.0), (0.8, 0.8, 0.6), teal, shading=(1.0, 1.0)), "glass"),
         textured_view(make_obj(5, "table", (3.5, 4.0), (0.8, 0.8, 0.6), (140, 95, 60), shading=(1.0, 1.0)), "wood"),
         textured_view(make_obj(6, "stool", (6.0, 4.0), (0.4, 0.4, 0.7), grey, shading=(1.0, 1.0)), "fabric"),
-        textured_view(make_obj(7, "stool", (8.0, 4.0), (0.4, 0.4, 0.7), grey, shading=(1.0, 1.0)), "wood"),
+        textured_view(make_obj(7, "stool", (8.0, 4.0), (0.4, 0.4, 0.7), grey, shading=(1.0, 1.0)), "leather"),
         make_obj(8, "desk", (1.0, 7.0), (1.2, 0.6, 0.75), (200, 200, 200)),
         make_obj(9, "desk", (3.5, 7.0), (1.2, 0.6, 0.75), (60, 60, 60)),
         make_obj(10, "cabinet", (6.0, 7.0), (1.0, 0.45, 0.9), (90, 60, 40)),
@@ -134,8 +134,8 @@ def test_a_part_takes_its_own_material(text, part, material):
 
 
 def test_a_part_the_map_does_not_observe_refuses_nothing(lounge):
-    # The only dresser's pixels show wood grain: its glass top is not seen apart, no evidence
-    # against it; "the glass dresser" is refused.
+    # The only dresser's pixels show a surface against glass (a weave): its glass top is not seen
+    # apart, so no evidence against it; "the glass dresser" is refused.
     res = lounge.query("the dresser with the glass top")
     assert res.found and res.chosen is not None and res.chosen.id == 3, res.reason
     assert "top" in res.reason
@@ -169,3 +169,28 @@ def test_straight_is_read_and_never_judged(lounge, text):
 ])
 def test_a_shape_word_said_of_the_motion_is_no_shape(text, shapes):
     assert parse_instruction(text).shapes == shapes, text
+
+
+@pytest.mark.parametrize(("text", "negated"), [
+    ("the stool that is neither wood nor metal", {"wood", "metal"}),
+    ("the ottoman, not the leather one and not the tan one", {"leather", "tan"}),
+    ("neither the white desk nor the grey one", {"white", "grey"}),
+])
+def test_each_of_several_negations_is_its_own(text, negated):
+    q = parse_instruction(text)
+    assert set(q.negations) == negated and not q.materials, (text, q.negations, q.materials)
+
+
+def test_neither_material_is_the_one_that_shows_neither(lounge):
+    # The woven stool shows no grain: "neither wood nor leather" is not the grainy one.
+    res = lounge.query("the stool that is neither wood nor leather")
+    assert res.chosen is not None and res.chosen.id == 6, res.reason
+
+
+@pytest.mark.parametrize(("text", "shapes", "materials"), [
+    ("the boxy-looking bench", ["rectangular"], []),
+    ("the glassy-looking table", [], ["glass"]),
+])
+def test_how_it_looks_is_its_first_part(text, shapes, materials):
+    q = parse_instruction(text)
+    assert (q.shapes, q.materials) == (shapes, materials), text

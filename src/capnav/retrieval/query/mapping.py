@@ -50,10 +50,12 @@ from capnav.retrieval.query.tokens import (
 if TYPE_CHECKING:
     from capnav.language.embedder import TextEmbedder
 
-#: "not the white one", "the one that isn't grey", "other than the red one", "except the ...".
+#: "not the white one", "the one that isn't grey", "other than the red one", "except the ...",
+#: "neither wood nor metal"; "not the leather one and not the grey one" is two negations.
 _NEGATION = re.compile(r"(?:\b(?:that|which|who)\s+)?(?:\bis\s+not\b|\bisn't\b|\bisnt\b|\bnot\b|\bother\s+than\b"
-                       r"|\bexcept(?:\s+for)?\b|\bapart\s+from\b|\brather\s+than\b|\binstead\s+of\b)"
-                       r"\s+(?P<neg>[^,;]+?)(?=\s*(?:[,;]|\bbut\b|\bthe\s+other\b|$))")
+                       r"|\bexcept(?:\s+for)?\b|\bapart\s+from\b|\brather\s+than\b|\binstead\s+of\b"
+                       r"|(?:\bis\s+)?\bneither\b(?=.*\bnor\b))"
+                       r"\s+(?P<neg>[^,;]+?)(?=\s*(?:[,;]|\bbut\b|\bthe\s+other\b|\b(?:and|or)\s+(?=not\b|isn't\b)|$))")
 #: "non-leather", "non wooden": the prefix negates an attribute word.
 _NON = re.compile(r"\bnon\s*-?\s*([a-z]+(?:-[a-z]+)?)\b")
 #: The robot itself as the reference of closest / farthest.
@@ -407,14 +409,23 @@ def _negations(q: ParsedQuery, head: str) -> str:
     return " ".join(out.split())
 
 
+def _knows(w: str) -> bool:
+    """``w`` says an attribute: a colour, shape or material word, or one of the lexicon's."""
+    return (w in LEXICON or w in ALIASES or w in _COLOUR_OF or w in _SHAPES or material_of(w) is not None
+            or w in _LEX.attributes)
+
+
 def _joined_compounds(words: list[str]) -> list[str]:
     """A verb and its particle said apart that the lexicon knows as one hyphenated attribute ("a
     table you can see through", "see right through": WordNet's "see-through", glass): the two
     words become that form; an adverb between them ("right", "straight", "clean") goes with them.
     Words that say something alone are read alone ("light blue" stays a light blue, not the
     lexicon's "light-blue"), and a determiner, a conjunction, a preposition ("see into through
-    the top": through the top is a part) or an object word between them is another phrase."""
-    out = list(words)
+    the top": through the top is a part) or an object word between them is another phrase. A word
+    of how it looks ("boxy-looking") is its first part when that part is an attribute word."""
+    # "boxy-looking", "glassy-seeming": how it looks is what its first part says.
+    out = [w.rsplit("-", 1)[0] if re.fullmatch(r"[a-z]+-(?:looking|seeming)", w)
+           and _knows(w.rsplit("-", 1)[0]) else w for w in words]
     k = 0
     while k < len(out) - 1:
         for gap in (1, 2):
