@@ -492,8 +492,9 @@ def _materials(wn: Any, forms: dict[str, str], labels: dict[str, str]) -> tuple[
     stay colours) and room words are left out: the word must not change what else it says.
 
     Second table: words whose adjective names no material but whose noun does ("plush": lavish,
-    and a fabric), read as a material only where said as a noun (after the target's noun: "covered
-    in soft plush"). A fabric defined by velvet (velour, velveteen, plush) is velvet: its pile
+    and a fabric), and colour words that are a material's noun ("oak", "walnut"), read as a
+    material only where said as a noun (in a phrase after the target's noun: "covered in soft
+    plush", "made from solid oak"). A fabric defined by velvet (velour, velveteen, plush) is velvet: its pile
     shows no weave, which is what the surface test tells velvet from a woven fabric by."""
     by_synset = {n: m for m, names in MATERIAL_ROOTS.items() for n in names}
     colour_words = set(LEXICON) | set(ALIASES)
@@ -546,6 +547,12 @@ def _materials(wn: Any, forms: dict[str, str], labels: dict[str, str]) -> tuple[
                     return pile(n, m)
         return None
 
+    def words_of_roots() -> set[str]:
+        # Colour words that are also a material's noun ("oak", "walnut", "gold"): a colour before
+        # the target ("the oak table"), a material in "made of solid oak" (the noun table only).
+        return {lem.name() for names in MATERIAL_ROOTS.values() for n in names
+                for s in [wn.synset(n), *wn.synset(n).closure(lambda x: x.hyponyms())] for lem in s.lemmas()}
+
     words: set[str] = set()
     for names in MATERIAL_ROOTS.values():
         for n in names:
@@ -563,10 +570,10 @@ def _materials(wn: Any, forms: dict[str, str], labels: dict[str, str]) -> tuple[
                 words.add(lem.name())
     out: dict[str, str] = {}
     nouns: dict[str, str] = {}
-    for w in sorted(words):
-        if not w.isalpha() or w != w.lower() or w in forms or w in labels or w in colour_words or w in ROOM_WORDS:
+    for w in sorted(words | (colour_words & words_of_roots())):
+        if not w.isalpha() or w != w.lower() or w in forms or w in labels or w in ROOM_WORDS:
             continue
-        m = material(w)
+        m = material(w) if w not in colour_words else None
         if m is not None:
             out[w] = m
         elif (m := material(w, as_noun=True)) is not None:

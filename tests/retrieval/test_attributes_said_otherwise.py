@@ -194,3 +194,18 @@ def test_neither_material_is_the_one_that_shows_neither(lounge):
 def test_how_it_looks_is_its_first_part(text, shapes, materials):
     q = parse_instruction(text)
     assert (q.shapes, q.materials) == (shapes, materials), text
+
+
+@pytest.mark.parametrize(("text", "materials"), [
+    ("the bookshelf made from solid oak", ["wood"]),
+    ("the bench carved out of walnut", ["wood"]),
+    ("the oak bookshelf", []),  # a colour before the noun, as the captions say it
+    ("the bookshelf, the walnut one", []),
+])
+def test_a_colour_word_is_a_material_where_said_as_what_it_is_made_of(text, materials):
+    assert parse_instruction(text).materials == materials, text
+
+
+def test_a_colour_said_as_a_cloth_stays_a_colour():
+    q = parse_instruction("the armchair in khaki")
+    assert q.materials == [] and q.colors, q.to_dict()

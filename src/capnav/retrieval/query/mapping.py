@@ -409,6 +409,21 @@ def _negations(q: ParsedQuery, head: str) -> str:
     return " ".join(out.split())
 
 
+def _material_nouns_after(words: list[str], end: int) -> list[str]:
+    """The words of the lexicon's ``material_nouns`` after ``end`` (the target's noun) that follow
+    a preposition of what a thing is made of or covered in ("of", "from", "in", "with"); a colour
+    word only after one of what it is made of ("of", "from": "made from oak"; "in khaki" is a
+    colour)."""
+    out, covered, made = [], False, False
+    for w in words[end:]:
+        covered = covered or w in ("of", "from", "in", "with")
+        made = made or w in ("of", "from")
+        colour = w in LEXICON or w in ALIASES or w in _COLOUR_OF
+        if (made if colour else covered) and w in _LEX.material_nouns and material_of(w) is None:
+            out.append(w)
+    return out
+
+
 def _knows(w: str) -> bool:
     """``w`` says an attribute: a colour, shape or material word, or one of the lexicon's."""
     return (w in LEXICON or w in ALIASES or w in _COLOUR_OF or w in _SHAPES or material_of(w) is not None
@@ -672,10 +687,10 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
         q.shapes = list(dict.fromkeys([*q.shapes, "L-shaped"]))
     q.materials = materials_in(_without_parts(q, words))
     cat, span, fuzzy = _find_category(words)
-    # A word that is a material only as a noun ("plush": lavish as an adjective) is one when said
-    # after the target's noun ("the armchair covered in soft plush"), not before it.
-    said_after = [w for w in words[span[1]:] if w in _LEX.material_nouns and material_of(w) is None] \
-        if span is not None else []
+    # A word that is a material only as a noun ("plush": lavish as an adjective; "oak": a colour
+    # before a noun) is one when said in a phrase after the target's noun ("the armchair covered
+    # in soft plush", "made from solid oak"), not before it.
+    said_after = _material_nouns_after(words, span[1]) if span is not None else []
     q.materials = list(dict.fromkeys([*q.materials, *(_LEX.material_nouns[w] for w in said_after)]))
     other = _other_object(words, span) if cat in BY_NAME else None  # a class's own compound names it
     if other is not None:
