@@ -741,10 +741,10 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                 if best is not None:
                     # The lexicon's relatives of each category that serves (a stool beside a chair),
                     # weighted below it: a room or a landmark can then choose among them.
-                    for c, w in [(best, 1.0), *alts.items()]:
+                    for c, wt in [(best, 1.0), *alts.items()]:
                         for other, w2 in _LEX.category_alternatives(c).items():
                             if other != best:
-                                alts[other] = max(alts.get(other, 0.0), round(w * w2, 3))
+                                alts[other] = max(alts.get(other, 0.0), round(wt * w2, 3))
                     q.category, q.category_alternatives, q.unknown_words = best, alts, []
     else:
         q.unknown_words = rest
