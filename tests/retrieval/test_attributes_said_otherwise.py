@@ -209,3 +209,11 @@ def test_a_colour_word_is_a_material_where_said_as_what_it_is_made_of(text, mate
 def test_a_colour_said_as_a_cloth_stays_a_colour():
     q = parse_instruction("the armchair in khaki")
     assert q.materials == [] and q.colors, q.to_dict()
+
+
+@pytest.mark.parametrize(("text", "category"), [
+    ("the stone counter", "counter"),  # "stone" is one letter from "stove"
+    ("take me to the stone bench", "bench"),
+])
+def test_a_material_word_read_as_a_typo_before_an_exact_name_is_its_modifier(text, category):
+    assert parse_instruction(text).category == category, text
