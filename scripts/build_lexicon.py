@@ -110,6 +110,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import shutil
 import sys
 import tempfile
@@ -212,7 +213,8 @@ def build(wordnet: Path) -> dict[str, Any]:
         out["kinds"] = _kinds(wn, out["forms"])
         out["placing"] = _placing(wn)
         out["body"] = _body(wn, noun_exc)
-        out["materials"] = _materials(wn, out["forms"], out["labels"])
+        out["materials"], out["material_nouns"] = _materials(wn, out["forms"], out["labels"])
+        out["surface_nouns"] = _surface_nouns(wn)
         out["rooms"] = _rooms(wn, out["forms"], noun_exc)
         out["attributes"] = _attributes(wn, out)
         out["forms"] = dict(sorted(out["forms"].items()))
@@ -463,13 +465,37 @@ NOT_MATERIALS = {"piece_of_cloth.n.01"}
 MATERIAL_SENSES = 2
 
 
-def _materials(wn: Any, forms: dict[str, str], labels: dict[str, str]) -> dict[str, str]:
+#: Nouns for how a whole object looks or feels, not a part of it: "the sofa with the velvety
+#: feel", "a cabinet with a walnut finish" say the material of the whole (the surface the pixels
+#: show), "the dresser with the glass top" that of a part. The synsets' lemmas (and the kinds of
+#: tactile property: texture, touch).
+SURFACE_NOUN_SENSES = ["appearance.n.01", "look.n.03", "tactile_property.n.01", "coating.n.02", "surface.n.01",
+                       "upholstery.n.01", "covering.n.02"]
+
+
+def _surface_nouns(wn: Any) -> list[str]:
+    out: set[str] = set()
+    for n in SURFACE_NOUN_SENSES:
+        s = wn.synset(n)
+        for x in [s, *(s.hyponyms() if n == "tactile_property.n.01" else [])]:
+            out |= {lem.name() for lem in x.lemmas() if lem.name().isalpha() and lem.name() == lem.name().lower()}
+    plural = {w + ("es" if w.endswith(("s", "x", "ch", "sh")) else "s") for w in out if not w.endswith("y")}
+    return sorted(out | plural | {w[:-1] + "ies" for w in out if w.endswith("y")})
+
+
+def _materials(wn: Any, forms: dict[str, str], labels: dict[str, str]) -> tuple[dict[str, str], dict[str, str]]:
     """Material words -> the material they are ("velvety" velvet, "oak" wood, "suede" leather,
     "chenille" fabric, "brass" metal), from WordNet: a word is a material when one of its first
     ``MATERIAL_SENSES`` senses lies under a material's synsets (the nearest one above it wins, so
     velvet stays velvet rather than fabric), for an adjective through the noun it is derived from
     or pertains to. Category and detector-class forms, colour words ("walnut", "gold", "ivory"
-    stay colours) and room words are left out: the word must not change what else it says."""
+    stay colours) and room words are left out: the word must not change what else it says.
+
+    Second table: words whose adjective names no material but whose noun does ("plush": lavish,
+    and a fabric), and colour words that are a material's noun ("oak", "walnut"), read as a
+    material only where said as a noun (in a phrase after the target's noun: "covered in soft
+    plush", "made from solid oak"). A fabric defined by velvet (velour, velveteen, plush) is velvet: its pile
+    shows no weave, which is what the surface test tells velvet from a woven fabric by."""
     by_synset = {n: m for m, names in MATERIAL_ROOTS.items() for n in names}
     colour_words = set(LEXICON) | set(ALIASES)
 
@@ -497,10 +523,18 @@ def _materials(wn: Any, forms: dict[str, str], labels: dict[str, str]) -> dict[s
     def count(word: str, pos: str) -> int:
         return sum(lem.count() for s in wn.synsets(word, pos) for lem in s.lemmas() if lem.name().lower() == word)
 
-    def material(word: str) -> str | None:
+    def pile(n: Any, m: str) -> str:
+        # A fabric defined by velvet ("heavy fabric that resembles velvet": velour; "a fabric with
+        # a nap ... softer than velvet": plush) has velvet's pile, which shows no weave: its surface
+        # is velvet's, the only fabric the surface test tells from a woven one.
+        return "velvet" if m == "fabric" and re.search(r"\bvelvet\b", n.definition()) else m
+
+    def material(word: str, as_noun: bool = False) -> str | None:
         # An adjective is read as one ("metallic", not the metallic fabric); a word used more often
-        # as a verb in the sense-tagged corpus ("lead", "iron") says something else first.
-        senses = wn.synsets(word, "a") + wn.synsets(word, "s") or wn.synsets(word, "n")
+        # as a verb in the sense-tagged corpus ("lead", "iron") says something else first. With
+        # ``as_noun``, the word's noun senses ("plush": lavish as an adjective, a fabric as a noun).
+        senses = wn.synsets(word, "n") if as_noun else wn.synsets(word, "a") + wn.synsets(word, "s") \
+            or wn.synsets(word, "n")
         if not senses or count(word, "v") > sum(count(word, p) for p in ("n", "a", "s")):
             return None
         for s in senses[:MATERIAL_SENSES]:
@@ -510,8 +544,14 @@ def _materials(wn: Any, forms: dict[str, str], labels: dict[str, str]) -> dict[s
             for n in nouns:
                 m = nearest(n)
                 if m is not None:
-                    return m
+                    return pile(n, m)
         return None
+
+    def words_of_roots() -> set[str]:
+        # Colour words that are also a material's noun ("oak", "walnut", "gold"): a colour before
+        # the target ("the oak table"), a material in "made of solid oak" (the noun table only).
+        return {lem.name() for names in MATERIAL_ROOTS.values() for n in names
+                for s in [wn.synset(n), *wn.synset(n).closure(lambda x: x.hyponyms())] for lem in s.lemmas()}
 
     words: set[str] = set()
     for names in MATERIAL_ROOTS.values():
@@ -529,13 +569,16 @@ def _materials(wn: Any, forms: dict[str, str], labels: dict[str, str]) -> dict[s
             if any(p.synset().name() in by_synset for p in lem.pertainyms()):
                 words.add(lem.name())
     out: dict[str, str] = {}
-    for w in sorted(words):
-        if not w.isalpha() or w != w.lower() or w in forms or w in labels or w in colour_words or w in ROOM_WORDS:
+    nouns: dict[str, str] = {}
+    for w in sorted(words | (colour_words & words_of_roots())):
+        if not w.isalpha() or w != w.lower() or w in forms or w in labels or w in ROOM_WORDS:
             continue
-        m = material(w)
+        m = material(w) if w not in colour_words else None
         if m is not None:
             out[w] = m
-    return out
+        elif (m := material(w, as_noun=True)) is not None:
+            nouns[w] = m
+    return out, nouns
 
 
 #: The shape words the parse reads (``capnav.retrieval.query.tokens._SHAPES``, judged by
@@ -562,6 +605,8 @@ def _attributes(wn: Any, lex: dict[str, Any]) -> dict[str, list[str]]:
       frequent adjective sense is there ("spherical", "disc-shaped": round; "oblong": long;
       "squishy", "padded": soft);
     - ``also_see``: the lemma of an adjective the head points to ("rounded": round);
+    - ``antonym``: a shape head's opposite no other table holds and its cluster ("straight",
+      "uncurved": straight, curved's antonym), of the unobserved kind (no curvature is measured);
     - ``gloss``: an adjective whose definition names the head's attribute noun ("boxy":
       "resembling a box in rectangularity", rectangularity being rectangular's noun);
     - ``definition``: a descriptive adjective (one with an attribute noun in WordNet, directly or
@@ -646,6 +691,29 @@ def _attributes(wn: Any, lex: dict[str, Any]) -> dict[str, list[str]]:
             for lemma in sorted(x.name() for x in other.lemmas()):
                 if adjective(lemma, {other}):
                     add(lemma, kind, value, "also_see")
+    # antonym: a shape head's opposite that no table holds ("straight", curved's antonym), with its
+    # cluster ("uncurved"), is read as its own word of the unobserved kind: the points measure no
+    # curvature (``capnav.language.form``: a curved sofa's footprint measured rectangular on the
+    # apartments), so neither straightness; it is read, noted and never judged. An opposite
+    # another table holds ("short": a height) is not read here.
+    head_names = {h.name() for kind, _, h in heads}
+    for kind, _, head in heads:
+        if kind != "shape":
+            continue
+        for other in sorted({a.synset() for lem in head.lemmas() for a in lem.antonyms()}, key=lambda x: x.name()):
+            word = other.lemmas()[0].name()
+            if other.name() in head_names or not usable(word):
+                continue
+            # The opposite's own word may be a shape in a later sense: "straight" is "successive"
+            # first, but one of its senses has WordNet's attribute shape ("having no deviations").
+            if adjective(word, {other}) or adjective(word, {x for x in adjective_senses(word)
+                                                            if any(t.name() == "shape.n.01" for t in x.attributes())},
+                                                     senses=len(adjective_senses(word))):
+                add(word, "unobserved", _form(word), "antonym")
+            for s in [other, *other.similar_tos()]:
+                for lemma in sorted(x.name() for x in s.lemmas()):
+                    if adjective(lemma, {s}):
+                        add(lemma, "unobserved", _form(word), "antonym")
     # gloss: an adjective whose definition names the noun of a head's lemma ("rectangularity").
     nouns: dict[str, tuple[str, str]] = {}
     for kind, value, head in heads:

@@ -158,5 +158,16 @@ def test_indirect_attribute_words_come_from_wordnet_s_relations():
     assert attrs["squishy"][:2] == ("unobserved", "soft")
     # A distance first ("far"), a colour that names a wood ("cherry"), words of other tables, and
     # words no relation reaches stay out.
-    for word in ("far", "cherry", "velvety", "big", "straight", "clear", "comfy", "light blue"):
+    for word in ("far", "cherry", "velvety", "big", "clear", "comfy", "light blue"):
         assert word not in attrs, word
+    # Curved's antonym (its own word, though "successive" first: a later sense has the attribute
+    # shape) is read as unobserved: the points measure no curvature.
+    assert attrs["straight"] == ("unobserved", "straight", "antonym")
+
+
+def test_material_nouns_and_pile_fabrics():
+    lex = load_lexicon()
+    assert lex.material_nouns["plush"] == "velvet" and "plush" not in lex.materials  # lavish as an adjective
+    assert lex.materials["velour"] == "velvet" and lex.materials["velveteen"] == "velvet"  # defined by velvet
+    assert lex.materials["corduroy"] == "fabric"
+    assert {"feel", "finish", "texture"} <= lex.surface_nouns and "top" not in lex.surface_nouns

@@ -56,6 +56,11 @@ class Lexicon:
     #: a material word -> the material the surface test knows ("velvety" velvet, "suede" leather,
     #: "teak" wood, "chenille" fabric, "brass" metal; WordNet's, see build_lexicon)
     materials: dict[str, str] = field(default_factory=dict)
+    #: a word that is a material as a noun only ("plush": lavish as an adjective, a fabric as a
+    #: noun) -> the material, read only where the word is said as a noun (see build_lexicon)
+    material_nouns: dict[str, str] = field(default_factory=dict)
+    #: nouns for how a whole looks or feels ("feel", "finish", "texture"), never a part of it
+    surface_nouns: frozenset[str] = frozenset()
     #: a height word ("tall", "stumpy", "lower") -> "large" / "small"; "tallest", "lowest" ->
     #: "largest" / "smallest" (WordNet's, see build_lexicon): compared with the mapped heights
     heights: dict[str, str] = field(default_factory=dict)
@@ -103,7 +108,9 @@ def load_lexicon() -> Lexicon:
                   persons=frozenset(raw.get("persons", [])),
                   kinds={k: tuple(v) for k, v in raw.get("kinds", {}).items()},
                   placing=frozenset(raw.get("placing", [])), body=frozenset(raw.get("body", [])),
-                  materials=dict(raw.get("materials", {})), heights=dict(raw.get("heights", {})),
+                  materials=dict(raw.get("materials", {})), material_nouns=dict(raw.get("material_nouns", {})),
+                  surface_nouns=frozenset(raw.get("surface_nouns", [])),
+                  heights=dict(raw.get("heights", {})),
                   height_superlatives=dict(raw.get("height_superlatives", {})),
                   rooms=dict(raw.get("rooms", {})),
                   attributes={k: (v[0], v[1], v[2]) for k, v in raw.get("attributes", {}).items()})

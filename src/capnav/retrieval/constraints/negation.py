@@ -72,6 +72,11 @@ class Negation(RankingConstraint):
             except InputError:
                 continue
             if nq.category is not None and nq.category != q.category and not nq.colors and not nq.room:
+                if nq.category in q.category_alternatives and not nq.has_attributes:
+                    # "not either of the desks, the cabinet": a negated category never answers
+                    # while another candidate fits, not even as a stand-in.
+                    for i in pool[r.cats_arr[pool] == nq.category]:
+                        out.setdefault(int(i), phrase)
                 continue  # "not the one at the end of the counter": a relation this reader does not judge
             fits = np.ones(len(pool), dtype=bool)
             judged = False

@@ -50,10 +50,12 @@ from capnav.retrieval.query.tokens import (
 if TYPE_CHECKING:
     from capnav.language.embedder import TextEmbedder
 
-#: "not the white one", "the one that isn't grey", "other than the red one", "except the ...".
+#: "not the white one", "the one that isn't grey", "other than the red one", "except the ...",
+#: "neither wood nor metal"; "not the leather one and not the grey one" is two negations.
 _NEGATION = re.compile(r"(?:\b(?:that|which|who)\s+)?(?:\bis\s+not\b|\bisn't\b|\bisnt\b|\bnot\b|\bother\s+than\b"
-                       r"|\bexcept(?:\s+for)?\b|\bapart\s+from\b|\brather\s+than\b|\binstead\s+of\b)"
-                       r"\s+(?P<neg>[^,;]+?)(?=\s*(?:[,;]|\bbut\b|\bthe\s+other\b|$))")
+                       r"|\bexcept(?:\s+for)?\b|\bapart\s+from\b|\brather\s+than\b|\binstead\s+of\b"
+                       r"|(?:\bis\s+)?\bneither\b(?=.*\bnor\b))"
+                       r"\s+(?P<neg>[^,;]+?)(?=\s*(?:[,;]|\bbut\b|\bthe\s+other\b|\b(?:and|or)\s+(?=not\b|isn't\b)|$))")
 #: "non-leather", "non wooden": the prefix negates an attribute word.
 _NON = re.compile(r"\bnon\s*-?\s*([a-z]+(?:-[a-z]+)?)\b")
 #: The robot itself as the reference of closest / farthest.
@@ -309,13 +311,24 @@ def _passed_objects(q: ParsedQuery, head: str) -> str:
 
 def _shapes(words: list[str]) -> list[str]:
     """The shapes ``words`` name, once each. "Corner" is a shape only right before an object's
-    name ("the corner sofa"); "in the corner" says where a thing stands."""
+    name ("the corner sofa"); "in the corner" says where a thing stands. A shape word before a
+    word of direction says how to go ("straight to", "round the back")."""
     def names_object_at(i: int) -> bool:
         span = _find_category(words[i:i + 2])[1]
         return span is not None and span[0] == 0
 
+    def of_the_motion(i: int) -> bool:
+        # "go straight to the sofa", "head straight ahead", "come round the back": a shape word
+        # before a preposition, an adverb of direction or a determiner says how to go, not a shape.
+        return i + 1 < len(words) and words[i + 1] in _MOTION_NEXT
+
     return list(dict.fromkeys(_SHAPES[w] for i, w in enumerate(words)
-                              if w in _SHAPES and (w != "corner" or names_object_at(i + 1))))
+                              if w in _SHAPES and (w != "corner" or names_object_at(i + 1)) and not of_the_motion(i)))
+
+
+_MOTION_NEXT = {"to", "towards", "toward", "for", "ahead", "on", "onto", "through", "into", "over", "across",
+                "past", "back", "down", "up", "away", "at", "there", "here", "along", "the", "a", "an", "my",
+                "your", "our", "this"}
 
 
 def relation_name(rel: str) -> str:
@@ -373,7 +386,10 @@ def _negations(q: ParsedQuery, head: str) -> str:
             continue
         cat, span, _ = _find_category(words)
         before = _find_category(out[: m.start()].split())[0]
-        if cat is not None and before is not None and before != cat:
+        # The wanted one may be said after the negation ("not the desk, the cabinet by the wall",
+        # "not either of the desks but the cabinet"): another category there names the target too.
+        after = _find_category(_after_negation(out[m.end():]).split())[0]
+        if cat is not None and ((before is not None and before != cat) or (after is not None and after != cat)):
             # "the sink, not the bathtub": another kind than the one asked for is excluded whole.
             out = out[: m.start()] + " " + out[m.end():]
             q.negations.append(" ".join(w for w in words if w not in _DETERMINERS))
@@ -391,6 +407,107 @@ def _negations(q: ParsedQuery, head: str) -> str:
                 q.negations.append(" ".join(part))
     out = re.sub(r"\bthe\s+other\s+(?:one|of\s+the\s+two)\b", " ", out)
     return " ".join(out.split())
+
+
+def _material_nouns_after(words: list[str], end: int) -> list[str]:
+    """The words of the lexicon's ``material_nouns`` after ``end`` (the target's noun) that follow
+    a preposition of what a thing is made of or covered in ("of", "from", "in", "with"); a colour
+    word only after one of what it is made of ("of", "from": "made from oak"; "in khaki" is a
+    colour)."""
+    out, covered, made = [], False, False
+    for w in words[end:]:
+        covered = covered or w in ("of", "from", "in", "with")
+        made = made or w in ("of", "from")
+        colour = w in LEXICON or w in ALIASES or w in _COLOUR_OF
+        if (made if colour else covered) and w in _LEX.material_nouns and material_of(w) is None:
+            out.append(w)
+    return out
+
+
+def _knows(w: str) -> bool:
+    """``w`` says an attribute: a colour, shape or material word, or one of the lexicon's."""
+    return (w in LEXICON or w in ALIASES or w in _COLOUR_OF or w in _SHAPES or material_of(w) is not None
+            or w in _LEX.attributes)
+
+
+def _joined_compounds(words: list[str]) -> list[str]:
+    """A verb and its particle said apart that the lexicon knows as one hyphenated attribute ("a
+    table you can see through", "see right through": WordNet's "see-through", glass): the two
+    words become that form; an adverb between them ("right", "straight", "clean") goes with them.
+    Words that say something alone are read alone ("light blue" stays a light blue, not the
+    lexicon's "light-blue"), and a determiner, a conjunction, a preposition ("see into through
+    the top": through the top is a part) or an object word between them is another phrase. A word
+    of how it looks ("boxy-looking") is its first part when that part is an attribute word."""
+    # "boxy-looking", "glassy-seeming": how it looks is what its first part says.
+    out = [w.rsplit("-", 1)[0] if re.fullmatch(r"[a-z]+-(?:looking|seeming)", w)
+           and _knows(w.rsplit("-", 1)[0]) else w for w in words]
+    k = 0
+    while k < len(out) - 1:
+        for gap in (1, 2):
+            if k + gap >= len(out):
+                break
+            form = f"{out[k]}-{out[k + gap]}"
+            said = any(w in LEXICON or w in ALIASES or w in _COLOUR_OF or w in _SHAPES or material_of(w) is not None
+                       or _find_category([w])[0] is not None for w in out[k:k + gap + 1])
+            apart = any(w in _DETERMINERS or w in _FILLER or w in _PREPOSITIONS for w in out[k + 1:k + gap])
+            if form in _LEX.attributes and not said and not apart:
+                out[k:k + gap + 1] = [form]
+                break
+        k += 1
+    return out
+
+
+_PREPOSITIONS = _MOTION_NEXT | {"in", "out", "under", "off", "from", "of", "by", "with", "behind", "inside"}
+
+
+#: Words that say a part follows: "the dresser with the glass top", "a stool that has a leather seat".
+_HAVING = {"with", "has", "having", "have"}
+_PART_DETERMINERS = {"a", "an", "the", "its", "their", "some", "two", "three", "four"}
+
+
+def _without_parts(q: ParsedQuery, words: list[str]) -> list[str]:
+    """``words`` without the materials said of a part ("the dresser with the glass top": glass is
+    the top's), which go to ``q.part_materials`` with a note: the map observes an object's surface
+    as a whole, not its parts apart, so a part's material is neither for nor against it. A part is
+    the first word after "with" / "has" and its modifiers that no table of the lexicon holds (not
+    a category, colour, material, size or shape word) and no noun of how the whole looks or feels
+    ("the sofa with the velvety feel", "a walnut finish": the lexicon's ``surface_nouns``): "the
+    table with glass" keeps its glass."""
+    out = list(words)
+    for k, w in enumerate(words):
+        if w not in _HAVING:
+            continue
+        j = k + 1
+        while j < len(words) and words[j] in _PART_DETERMINERS:
+            j += 1
+        mods = j
+        while j < len(words) and (material_of(words[j]) is not None or words[j] in LEXICON or words[j] in ALIASES
+                                  or words[j] in _SHAPES or words[j] in _SIZE_TOKENS):
+            j += 1
+        if j == mods or j >= len(words):
+            continue
+        part = words[j]
+        if not part.isalpha() or part in _FILLER or part in _HAVING or part in _LEX.surface_nouns \
+                or _find_category([part])[0] is not None:
+            continue
+        mats = materials_in(words[mods:j])
+        if not mats:
+            continue
+        q.part_materials.setdefault(part, []).extend(m for m in mats if m not in q.part_materials.get(part, []))
+        q.notes.append(f"{'/'.join(mats)} is said of its {part}, which the map does not observe apart "
+                       f"(neither for nor against it)")
+        for i in range(mods, j):
+            if material_of(words[i]) is not None:
+                out[i] = ""
+    return [w for w in out if w]
+
+
+def _after_negation(rest: str) -> str:
+    """The words after a negated phrase up to the next negation: those of the phrase that says
+    which one is meant ("..., the cabinet by the wall"; "... but the cabinet")."""
+    rest = re.sub(r"^\s*(?:[,;]|\bbut\b)\s*", " ", rest)
+    nxt = _NEGATION.search(rest)
+    return rest[: nxt.start()] if nxt is not None else rest
 
 
 _FROM_ROBOT = "the robot"
@@ -553,7 +670,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                     q.anchor_phrase = m.group(1)
                     head = head[:m.start()]
                     break
-    words = [w for w in re.split(r"\s+", head.strip()) if w]
+    words = _joined_compounds([w for w in re.split(r"\s+", head.strip()) if w])
     for phrase in sorted(_SUPERLATIVE, key=len, reverse=True):
         if phrase in head and re.search(rf"\b{phrase}\b", head):
             q.superlative, q.size_axis = _SUPERLATIVE[phrase], size_axis(phrase)
@@ -568,8 +685,13 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     q.shapes = _shapes(words)
     if "l-shaped" in head or "l shaped" in head:
         q.shapes = list(dict.fromkeys([*q.shapes, "L-shaped"]))
-    q.materials = materials_in(words)
+    q.materials = materials_in(_without_parts(q, words))
     cat, span, fuzzy = _find_category(words)
+    # A word that is a material only as a noun ("plush": lavish as an adjective; "oak": a colour
+    # before a noun) is one when said in a phrase after the target's noun ("the armchair covered
+    # in soft plush", "made from solid oak"), not before it.
+    said_after = _material_nouns_after(words, span[1]) if span is not None else []
+    q.materials = list(dict.fromkeys([*q.materials, *(_LEX.material_nouns[w] for w in said_after)]))
     other = _other_object(words, span) if cat in BY_NAME else None  # a class's own compound names it
     if other is not None:
         # "pool table", "power plant": WordNet names another object ending in a category word.
@@ -587,7 +709,8 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
              | set(_MATERIAL_OF) | _COMMON_ADJECTIVES | {w for c in q.colors for w in c.split()}
              | (_GROWTH_TOKENS if cat == "plant" else set())
              | {w for w in words if re.fullmatch(r"[a-z]+-colou?red", w) or material_of(w)}
-             | set(UNOBSERVED) | {w for w in words if w in _COLOUR_OF and _COLOUR_OF[w] in q.colors})
+             | set(UNOBSERVED) | {w for w in words if w in _COLOUR_OF and _COLOUR_OF[w] in q.colors}
+             | set(said_after))
     for w in dict.fromkeys(w for w in words if w in UNOBSERVED):
         # "the squishy armchair": WordNet's soft; no map observes it, so it neither confirms nor refuses.
         q.notes.append(f"'{w}' says {UNOBSERVED[w]}, which the map does not observe")
@@ -618,10 +741,10 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                 if best is not None:
                     # The lexicon's relatives of each category that serves (a stool beside a chair),
                     # weighted below it: a room or a landmark can then choose among them.
-                    for c, w in [(best, 1.0), *alts.items()]:
+                    for c, wt in [(best, 1.0), *alts.items()]:
                         for other, w2 in _LEX.category_alternatives(c).items():
                             if other != best:
-                                alts[other] = max(alts.get(other, 0.0), round(w * w2, 3))
+                                alts[other] = max(alts.get(other, 0.0), round(wt * w2, 3))
                     q.category, q.category_alternatives, q.unknown_words = best, alts, []
     else:
         q.unknown_words = rest

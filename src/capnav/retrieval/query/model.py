@@ -54,6 +54,9 @@ class ParsedQuery:
     #: The target was named by a word for any object ("the third thing you reach", "the one by the
     #: door") with a predicate that picks it: every category may answer.
     generic: bool = False
+    #: Materials said of a part of the target ("the dresser with the glass top": top -> glass):
+    #: the map observes no part apart, so they neither confirm nor refuse (a note says so).
+    part_materials: dict[str, list[str]] = field(default_factory=dict)
 
     @property
     def has_attributes(self) -> bool:

@@ -241,12 +241,18 @@ def _find_category(words: list[str]) -> tuple[str | None, tuple[int, int] | None
     """(category, word span, fuzzy) of the first object mention: a category (exact n-grams before
     typos), or a detector class named before it ("the mug on the table": a cup)."""
     cat, span, fuzzy = _find_vocabulary(words)
-    while span is not None and not fuzzy and (nxt := _exact_at(words, span[1])) is not None:
+    while span is not None and (nxt := _exact_at(words, span[1])) is not None:
         # A noun compound's head is its last noun: "the desk chair" is a chair, "the tv cabinet"
-        # a cabinet; the category word before it says what kind.
+        # a cabinet; the category word before it says what kind. A word read as a typo right
+        # before an exact name is its modifier ("the stone counter" is no stove).
         cat, span = nxt
+        fuzzy = False
     # A class's exact name also beats a typo read at the same place ("hair drier" is no "chair").
     label = _find_label(words, len(words) if span is None else span[0] + int(fuzzy))
+    if label is None and fuzzy and span is not None:
+        # ... and a class's exact name right after a typo read ("the stone bench": a bench).
+        label = _find_label(words[span[1]:], 1)
+        label = None if label is None else (label[0], (span[1] + label[1][0], span[1] + label[1][1]), False)
     return label if label is not None else (cat, span, fuzzy)
 
 
