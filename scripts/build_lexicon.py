@@ -215,6 +215,9 @@ def build(wordnet: Path) -> dict[str, Any]:
         out["materials"] = _materials(wn, out["forms"], out["labels"])
         out["rooms"] = _rooms(wn, out["forms"], noun_exc)
         out["attributes"] = _attributes(wn, out)
+        out["room_glosses"] = _room_glosses(wn)
+        out["gloss_adjectives"] = _gloss_adjectives(wn, out)
+        out["furniture_senses"] = _furniture_senses(wn, out["forms"])
         out["forms"] = dict(sorted(out["forms"].items()))
         return out
 
@@ -431,7 +434,9 @@ def _kinds(wn: Any, forms: dict[str, str]) -> dict[str, list[str]]:
 #: support", "place temporarily"; and, with their hyponyms (plonk, plunk, plump down), "put or
 #: settle into a position" and "cause to ... be in a settled position or place". Not the
 #: hyponyms of the first ones: they bury, sow, bottle and install.
-PLACING_SENSES = ["put.v.01", "lay.v.02", "rest.v.08", "park.v.01"]
+#: ``leave.v.02`` ("go and leave behind, either intentionally or by neglect"): a thing left
+#: somewhere stays where it was left ("she left her bag by the bed", "where can I leave my keys").
+PLACING_SENSES = ["put.v.01", "lay.v.02", "rest.v.08", "park.v.01", "leave.v.02"]
 PLACING_TREES = ["set_down.v.03", "set_down.v.04"]
 
 
@@ -854,6 +859,93 @@ def _rooms_of_fixtures(wn: Any) -> dict[str, list[str]]:
         for cat in ROOTS:
             if what in (cat, cat + "s", cat + "es"):
                 out.setdefault(cat, []).append(syn.name() + "!")  # not its hyponyms (public toilets)
+    return out
+
+
+def _room_glosses(wn: Any) -> dict[str, list[str]]:
+    """Room type -> WordNet's definitions of its ``ROOM_ROOTS`` ("a room equipped for preparing
+    meals"), so that an activity can say which room it is done in ("making tea": the kitchen)."""
+    return {room: list(dict.fromkeys(wn.synset(n.rstrip("!")).definition() for n in roots))
+            for room, roots in ROOM_ROOTS.items()}
+
+
+def _gloss_adjectives(wn: Any, lex: dict[str, Any]) -> dict[str, list[str]]:
+    """Adjective -> the categories whose definitions say it, through its first sense: the lemmas
+    of that synset and, for a satellite, of its head ("cosy" -> cozy.s.01, whose head
+    comfortable.a.01 an easy chair's definition says: "a comfortable upholstered armchair"). A
+    place described by one ("a cosy place to read") is that furniture among the ones serving the
+    activity. Words of the size, height, colour, material and attribute tables are left to them."""
+    import re
+
+    def adjective(w: str) -> bool:  # a gloss word used as an adjective first ("comfortable")
+        first = wn.synsets(w)
+        return len(w) > 3 and bool(first) and first[0].pos() in "as"
+
+    def count(w: str, pos: str) -> int:
+        return sum(lem.count() for x in wn.synsets(w, pos) for lem in x.lemmas() if lem.name() == w)
+
+    words = {c: {w for w in re.findall(r"[a-z]+", " ".join(g).lower()) if adjective(w)}
+             for c, g in lex["glosses"].items()}
+    taken = set(lex["sizes"]) | set(lex["heights"]) | set(lex["materials"]) | set(lex["attributes"]) \
+        | set(LEXICON) | set(ALIASES) | set(lex["forms"])
+    out: dict[str, list[str]] = {}
+    for lemma in sorted(set(wn.all_lemma_names("a")) | set(wn.all_lemma_names("s"))):
+        if lemma != lemma.lower() or not lemma.isalpha() or lemma in taken:
+            continue
+        senses = [s for s in wn.synsets(lemma) if s.pos() in "as"]
+        if not senses or wn.synsets(lemma, "v") or count(lemma, "n") > count(lemma, "a"):
+            continue  # "cosy" (a tea cosy too, rarely said) yes, "wash" (a verb too) no
+        near = [senses[0], *(senses[0].similar_tos() if senses[0].pos() == "s" else [])]
+        said = {lem.name().lower() for x in near for lem in x.lemmas()}
+        cats = sorted(c for c, ws in words.items() if said & ws)
+        if cats and len(cats) <= 2:  # a word many definitions say ("small") picks nothing out
+            out[lemma] = cats
+    return out
+
+
+def _furniture_senses(wn: Any, forms: dict[str, str]) -> dict[str, dict[str, Any]]:
+    """Words whose first physical sense is something else but which WordNet also has as a piece
+    of furniture of a category, and only as that one (Irish and British "press": a printing press
+    first, the wardrobe's synonym "clothes press" too): word -> {"category", "synset",
+    "alternatives"}. Read only as the head of a request that names no category otherwise. The
+    alternatives are the categories of the first sense of the synset's other lemmas ("closet":
+    a cupboard, the cabinet). Words with an adjective sense ("lower") or that name a person
+    first ("secretary") are left out."""
+    excluded = {s.name() for n in EXCLUDE for s in wn.synset(n).closure(lambda x: x.hyponyms())} | set(EXCLUDE)
+    members = {cat: _closure(wn, roots, excluded) for cat, roots in ROOTS.items()}
+    owner: dict[str, str] = {}
+    for cat in sorted(members, key=lambda c: len(members[c]), reverse=True):
+        for s in members[cat]:
+            owner[s] = cat
+    furniture = wn.synset("furniture.n.01")
+    found: dict[str, set[str]] = {}
+    for name, cat in sorted(owner.items()):
+        syn = wn.synset(name)
+        if furniture not in syn.closure(lambda x: x.hypernyms()):
+            continue
+        for lem in syn.lemmas():
+            word = lem.name()
+            if word != word.lower() or not word.isalpha() or word in forms or word in ROOM_WORDS:
+                continue
+            nouns = wn.synsets(word, "n")
+            if not nouns or nouns[0].lexname() == "noun.person" or wn.synsets(word, "a") or wn.synsets(word, "s"):
+                continue
+            found.setdefault(word, set()).add(name)
+    out: dict[str, dict[str, Any]] = {}
+    for word, names in sorted(found.items()):
+        cats = {owner[n] for n in names}
+        if len(cats) != 1:
+            continue
+        name = sorted(names)[0]
+        alts: dict[str, float] = {}
+        for lem in wn.synset(name).lemmas():
+            other = lem.name()
+            if other == word:
+                continue
+            first = [x for x in wn.synsets(other, "n") if x.lexname() in PHYSICAL]
+            if first and first[0].name() in owner and owner[first[0].name()] not in cats:
+                alts[owner[first[0].name()]] = 0.5
+        out[word] = {"category": next(iter(cats)), "synset": name, "alternatives": dict(sorted(alts.items()))}
     return out
 
 

@@ -66,6 +66,15 @@ class Lexicon:
     #: "boxy" (shape, rectangular, gloss), "see-through" (material, glass, definition), "azure"
     #: (colour, blue, hypernym), "squishy" (unobserved, soft, similar_to); see build_lexicon
     attributes: dict[str, tuple[str, str, str]] = field(default_factory=dict)
+    #: room type -> WordNet's definitions of it ("a room equipped for preparing meals"): the room
+    #: an activity implies ("making tea": the kitchen; ``capnav.language.purpose.activity_room``)
+    room_glosses: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    #: an adjective -> the categories whose definitions say it through its first sense ("cosy":
+    #: comfortable, "a comfortable upholstered armchair"): what a place described by it is
+    gloss_adjectives: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    #: a word whose first sense is something else but which WordNet also has as one category's
+    #: furniture ("press": the wardrobe's "clothes press") -> {"category", "synset", "alternatives"}
+    furniture_senses: dict[str, dict[str, Any]] = field(default_factory=dict)
     load_seconds: float = 0.0
 
     def category_alternatives(self, category: str, form: str | None = None) -> dict[str, float]:
@@ -106,7 +115,10 @@ def load_lexicon() -> Lexicon:
                   materials=dict(raw.get("materials", {})), heights=dict(raw.get("heights", {})),
                   height_superlatives=dict(raw.get("height_superlatives", {})),
                   rooms=dict(raw.get("rooms", {})),
-                  attributes={k: (v[0], v[1], v[2]) for k, v in raw.get("attributes", {}).items()})
+                  attributes={k: (v[0], v[1], v[2]) for k, v in raw.get("attributes", {}).items()},
+                  room_glosses={k: tuple(v) for k, v in raw.get("room_glosses", {}).items()},
+                  gloss_adjectives={k: tuple(v) for k, v in raw.get("gloss_adjectives", {}).items()},
+                  furniture_senses=dict(raw.get("furniture_senses", {})))
     object.__setattr__(lex, "load_seconds", time.perf_counter() - t0)
     return lex
 
