@@ -14,7 +14,18 @@ from typing import TYPE_CHECKING
 from capnav.core.categories import BY_NAME
 from capnav.language.colors import ALIASES, LEXICON
 from capnav.language.context import ROOM_SYNONYMS
-from capnav.language.purpose import find_activity, is_placing, match_purpose, purpose_categories
+from capnav.language.purpose import (
+    MADE_FOR,
+    PurposeConfig,
+    activity_room,
+    find_activity,
+    is_placing,
+    match_purpose,
+    place_adjective,
+    purpose_categories,
+    room_text,
+    split_activity,
+)
 from capnav.retrieval.query.count import read_count, without
 from capnav.retrieval.query.model import ACROSS, BETWEEN, ROOM_WITH, ParsedQuery
 from capnav.retrieval.query.parse import _GENERIC, ROOM_ALONG, GoalParse, describe, passed_object
@@ -447,6 +458,27 @@ def _count(q: ParsedQuery, head: str) -> str:
     return without(head, c.spans)
 
 
+def _described_place(q: ParsedQuery, head: str, best: str | None, alts: dict[str, float],
+                     scores: dict[str, float]) -> tuple[str | None, dict[str, float]]:
+    """"a cosy place to read": the adjective said of the place is what the furniture's own
+    definitions say (WordNet: cosy is comfortable, "a comfortable upholstered armchair"), so of
+    the categories that serve the activity (within the purpose margin of the best fit, however
+    many there are) the ones it describes come first; when no furniture is made for the activity
+    (its best fit below ``MADE_FOR``), the furniture the adjective describes is the place."""
+    adj = place_adjective(head)
+    said = _LEX.gloss_adjectives.get(adj or "", ())
+    top = scores.get(best or "", 0.0)
+    fit = [c for c in said if c == best or c in alts or scores.get(c, -1.0) >= top - PurposeConfig().margin]
+    if not fit and top < MADE_FOR:
+        fit = list(said)  # nothing is made for the activity ("read": a lamp allows it): the place as described
+    if best is None or not fit or fit[0] == best:
+        return best, alts
+    new = fit[0]
+    out = {best: round(min(0.95, alts.get(new, 0.95)), 3), **{c: w for c, w in alts.items() if c != new}}
+    q.notes.append(f"'{adj}' place: WordNet's definitions say it of the {new}, which serves '{q.purpose}' too")
+    return new, dict(sorted(out.items(), key=lambda kv: -kv[1]))
+
+
 def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     """Read ``text``. With ``embedder`` (the retriever's), a request by purpose ("somewhere to
     sit") is mapped to categories through the lexicon's glosses; without one it keeps ``purpose``
@@ -527,7 +559,8 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     if q.anchor_category is None:
         for rel in _RELATIONS:
             m = re.search(rf"\b{rel}\s+(?:the\s+|a\s+|an\s+|my\s+)?(.+)$", head) if rel in head else None
-            if m and rel == "on" and _put_down(head[:m.start()].split()):
+            if m and rel == "on" and _put_down(head[:m.start()].split()) \
+                    and _find_category(m.group(1).split())[0] is not None:
                 head = m.group(1)  # "I put my mug down on the counter": where it was put is the goal
                 break
             if m and rel == "on" and _find_category(head[:m.start()].split())[0] is None:
@@ -614,7 +647,14 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
             _attributes_outside(q, head, activity)
             if embedder is not None:
                 # The retriever embeds the instruction next: one batch for both.
-                best, alts = purpose_categories(match_purpose(activity, embedder, along=(q.text,)))
+                # The act says the furniture; what it is done for ("before making tea") the room.
+                parts = split_activity(activity) or [activity]
+                act = parts[0]
+                # What it is done for says the room: embedded in the same run.
+                match = match_purpose(act, embedder, along=(q.text, *(room_text(p) for p in parts[1:])))
+                best, alts = purpose_categories(match)
+                q.placing = is_placing(act, scores=match.scores)
+                best, alts = _described_place(q, head, best, alts, match.scores)
                 if best is not None:
                     # The lexicon's relatives of each category that serves (a stool beside a chair),
                     # weighted below it: a room or a landmark can then choose among them.
@@ -623,6 +663,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                             if other != best:
                                 alts[other] = max(alts.get(other, 0.0), round(w * w2, 3))
                     q.category, q.category_alternatives, q.unknown_words = best, alts, []
+                    q.purpose_room = activity_room(activity, embedder)
     else:
         q.unknown_words = rest
     if q.category is None and q.purpose is None and any(w in _GENERIC for w in words):
