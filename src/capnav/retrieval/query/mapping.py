@@ -627,6 +627,14 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     if cat is not None and span is not None:
         form = " ".join(words[span[0]:span[1]])
         q.category_alternatives = _LEX.category_alternatives(cat, None if fuzzy else form)
+        sense = next((_LEX.furniture_senses[f] for f in (form, form[:-1], form[:-2]) if f in _LEX.furniture_senses),
+                     None)
+        if sense is not None and _LEX.forms.get(form) is None:
+            # "the kitchen press": WordNet's one furniture sense of a word that is first another thing.
+            for other, w in dict(sense.get("alternatives", {})).items():
+                q.category_alternatives[other] = max(q.category_alternatives.get(other, 0.0), float(w))
+            q.notes.append(f"'{form}' is read as the {cat}: its only furniture sense in WordNet "
+                           f"({sense['synset']}); its first sense is another thing")
         if cat in _LEX.kinds:
             # "the appliance on your left": every category of the kind is the named one.
             q.category, q.category_alternatives = None, dict.fromkeys(_LEX.kinds[cat], 1.0)
@@ -668,6 +676,11 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
         q.unknown_words = rest
     if q.category is None and q.purpose is None and any(w in _GENERIC for w in words):
         q.generic, q.unknown_words = True, []
+    if q.category is None and q.purpose is None and not q.generic and not q.category_alternatives and rest:
+        # "where's the dunny": a name neither WordNet nor the category table has; said plainly, and
+        # never answered by a lookalike word ("khaki").
+        q.notes.append(f"no object word here is known to the lexicon (WordNet 3.0 and the category table): "
+                       f"{rest[-1]!r}")
     desc = list(dict.fromkeys(w for part in (*q.colors, *q.materials, *q.shapes) for w in part.split()))
     noun = q.category if q.category is not None else cat if cat is not None else " ".join(rest[-2:]) if rest else ""
     q.target_phrase = " ".join([*desc, noun]).strip() or norm
