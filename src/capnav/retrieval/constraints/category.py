@@ -81,7 +81,8 @@ class Category(RankingConstraint):
 def stand_ins(q: ParsedQuery) -> set[str]:
     """Categories that may answer for the named one when the map has none of it: its hyponyms in
     the lexicon (``kind_of``), and the other senses of a word of the request (a commode may be a
-    dresser; a press, read as WordNet's wardrobe, may be the cupboard its synonym "closet" is). Not the more general categories, nor siblings: "the desk" is never the table.
+    dresser; a press, read as WordNet's wardrobe, may be the cupboard its synonym "closet" is).
+    Not the more general categories, nor siblings: "the desk" is never the table.
 
     The category table wins over WordNet's tree where they disagree: WordNet files "settee" under
     "bench", but the table makes settee a sofa, and "bench" names no category, so no sofa (nor a
