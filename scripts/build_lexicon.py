@@ -211,6 +211,7 @@ def build(wordnet: Path) -> dict[str, Any]:
         out["persons"] = _persons(wn, noun_exc)
         out["kinds"] = _kinds(wn, out["forms"])
         out["placing"] = _placing(wn)
+        out["placing_past"] = _placing_past(out["placing"], (wordnet / "verb.exc").read_text().splitlines())
         out["body"] = _body(wn, noun_exc)
         out["materials"] = _materials(wn, out["forms"], out["labels"])
         out["rooms"] = _rooms(wn, out["forms"], noun_exc)
@@ -447,6 +448,19 @@ def _placing(wn: Any) -> list[str]:
         for s in [wn.synset(n), *wn.synset(n).closure(lambda x: x.hyponyms())]:
             out |= {_form(lem.name()) for lem in s.lemmas()}
     return sorted(f for f in out if f.replace(" ", "").isalpha() and f == f.lower())
+
+
+def _placing_past(placing: list[str], exceptions: list[str]) -> dict[str, str]:
+    """Irregular inflections of the placing verbs from WordNet's exception list (``verb.exc``:
+    "left" leave, "laid" lay): "she left her bag by the bed" puts the bag where it was left."""
+    single = {p for p in placing if " " not in p}
+    out: dict[str, str] = {}
+    for line in exceptions:
+        infl, *bases = line.split()
+        base = next((b for b in bases if b in single), None)
+        if base is not None and infl not in single:
+            out[infl] = base
+    return dict(sorted(out.items()))
 
 
 #: The materials the surface test knows (``capnav.language.surface``), each with the WordNet

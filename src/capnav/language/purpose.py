@@ -261,8 +261,8 @@ def is_placing(activity: str, embedder: TextEmbedder | None = None,
     lex = load_lexicon()
     rooms = {w for r in lex.rooms for w in r.split()} | {"kitchen", "bedroom", "bathroom", "room", "office",
                                                          "hall", "hallway", "lounge", "house", "flat", "home"}
-    if any(v in lex.placing or f"{v} {words[1] if len(words) > 1 else ''}".strip() in lex.placing
-           for v in _verb_forms(words[0])):
+    verbs = [*_verb_forms(words[0]), *([lex.placing_past[words[0]]] if words[0] in lex.placing_past else [])]
+    if any(v in lex.placing or f"{v} {words[1] if len(words) > 1 else ''}".strip() in lex.placing for v in verbs):
         if any(w in _AWAY or w in lex.body or w in rooms for w in words[1:]):
             return False
         k = next((i for i, w in enumerate(words[1:], 1) if w in _PLACE_PREPS), None)

@@ -300,7 +300,7 @@ def _put_down(words: list[str]) -> bool:
     WordNet's, in any inflection; ``is_placing`` reads -ing and -s, the past tense is tried here):
     what follows "on" is where it was put."""
     for i, w in enumerate(words):
-        past = [w[:-1], w[:-2]] if w.endswith("ed") else []
+        past = [w[:-1], w[:-2]] if w.endswith("ed") else [_LEX.placing_past[w]] if w in _LEX.placing_past else []
         if is_placing(" ".join(words[i:i + 2])) or any(is_placing(stem) for stem in past):
             return True
     return False
@@ -574,6 +574,13 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                     q.relation = "next to" if rel in ("besides", "beside", "by", "close to", "alongside") else rel
                     q.anchor_category, q.anchor_phrase = stand_in[0], stand_in[1]
                     head = head[: m.start()]
+                    break
+                before = head[:m.start()].split()
+                if cat is not None and _put_down(before) and _find_category(before)[0] is None:
+                    # "she left her bag by the bed, go there": a thing the map does not hold was
+                    # left or put by the landmark; where it was left is the goal.
+                    q.notes.append(f"where it was put ({rel} the {cat}) is the goal")
+                    head = m.group(1)
                     break
                 if cat is not None and _verb_only(head[:m.start()]):
                     # "swing by the fridge", "pop by the stove": a verb of going with its
