@@ -40,7 +40,8 @@ is spoken to):
   with one or more toilets": lavatory, lav, privy). Lamps are ``lamp.n.02`` (the
   furniture), not ``lamp.n.01`` (any source of light: torches, searchlights).
 - ``other``: compounds whose last word is a category word but which name something else (a pool
-  table, a toilet seat, a power plant): game, operating, altar and work tables, wheelchairs,
+  table, a toilet seat, a power plant), and two-word compounds whose first word is one ("bath
+  towel", "bed linen": the category says what the thing is for): game, operating, altar and work tables, wheelchairs,
   hospital beds (``EXCLUDE``), and every WordNet noun ending in a category word whose first physical sense
   is outside that category. "the pool table" is then an object CapNav does not know, not a table.
 - ``relations``: for each ordered pair of categories, ``kind_of`` when one's synsets lie under the
@@ -876,6 +877,12 @@ def _rooms_of_fixtures(wn: Any) -> dict[str, list[str]]:
     return out
 
 
+def _part(syn: Any, owner: dict[str, str]) -> bool:
+    """Whether ``syn`` or a hypernym of it is a part of a category's object (WordNet's part
+    holonyms: a lampshade of the lamp)."""
+    return any(h.name() in owner for x in [syn, *syn.closure(lambda y: y.hypernyms())] for h in x.part_holonyms())
+
+
 def _room_glosses(wn: Any) -> dict[str, list[str]]:
     """Room type -> WordNet's definitions of its ``ROOM_ROOTS`` ("a room equipped for preparing
     meals"), so that an activity can say which room it is done in ("making tea": the kitchen)."""
@@ -1023,12 +1030,23 @@ def _build(wn: Any) -> dict[str, Any]:
             alternatives[form] = {o: 0.5 for o in sorted(others)}
     # Compounds ending in a category word that are something else.
     heads = {f.split()[-1] for f in forms}
+    # ... and compounds in which a category word names what the object is for ("bath towel",
+    # "bed linen"): the category word modifies another noun.
+    firsts = {f for f in forms if " " not in f}
     other: list[str] = []
     for lemma in wn.all_lemma_names("n"):
         form = _form(lemma)
         words = form.split()
-        if len(words) < 2 or len(words) > 3 or words[-1] not in heads or form in forms or lemma != lemma.lower():
+        if len(words) < 2 or len(words) > 3 or form in forms or lemma != lemma.lower():
             continue
+        first_word = words[-1] not in heads
+        if first_word and not (len(words) == 2 and words[0] in firsts and words[1] not in firsts):
+            continue
+        if first_word:
+            # Not a part of the object ("lamp shade", "toilet seat": the lamp, the toilet) nor a room.
+            sense = next(iter(physical_senses(lemma)), None)
+            if sense is None or sense.lexname() != "noun.artifact" or _part(sense, owner) or words[1] in ROOM_WORDS:
+                continue
         senses = physical_senses(lemma)
         if senses and senses[0].name() not in owner:
             other.append(form)

@@ -102,6 +102,7 @@ def test_a_thing_handled_that_no_furniture_is_made_for_is_put_down(emb, activity
     ("where can I wash my face before I brush my teeth", BATH_SINK),
     ("where do I put the laundry on a wash cycle", WASHER),
     ("these sheets need a hot wash, where can I put them on a cycle?", WASHER),
+    ("the bath towels need washing, where can I put them on a cycle?", WASHER),
 ])
 def test_the_activity_reaches_the_furniture_in_its_room(kitchen_and_bathroom: Retriever, text: str,
                                                         oid: int) -> None:
@@ -120,6 +121,14 @@ def test_the_activity_reaches_the_furniture_made_for_it(bedroom_and_study: Retri
                                                         oid: int) -> None:
     res = bedroom_and_study.query(text)
     assert res.found and res.chosen is not None and res.chosen.id == oid, res.reason
+
+
+@pytest.mark.parametrize(("text", "category"), [("the bath mat", None), ("the bed linen", None), ("the bath", "bathtub"),
+                                              ("the lamp shade", "lamp")])
+def test_a_compound_on_a_category_word_names_another_thing(text: str, category: str | None) -> None:
+    # WordNet's compounds whose first word is a category word ("bath towel") are another object;
+    # a part of the category's object ("lamp shade") is still that object.
+    assert parse_instruction(text, use_parser=False).category == category
 
 
 def test_a_place_adjective_is_no_unknown_target(emb) -> None:  # type: ignore[no-untyped-def]

@@ -458,6 +458,20 @@ def _count(q: ParsedQuery, head: str) -> str:
     return without(head, c.spans)
 
 
+def _without_modifying_categories(act: str) -> str:
+    """The activity without a category word that only says what another thing handled is for
+    ("put the bath towels on a cycle" -> "put the towels on a cycle"): WordNet's compound names
+    the towel, and its "bath" is no furniture the activity asks for."""
+    words = act.split()
+    out = []
+    for k, w in enumerate(words):
+        nxt = " ".join(words[k:k + 2])
+        if k + 1 < len(words) and w in _LEX.forms and (nxt in _LEX.other or nxt[:-1] in _LEX.other):
+            continue
+        out.append(w)
+    return " ".join(out) or act
+
+
 def _described_place(q: ParsedQuery, head: str, best: str | None, alts: dict[str, float],
                      scores: dict[str, float]) -> tuple[str | None, dict[str, float]]:
     """"a cosy place to read": the adjective said of the place is what the furniture's own
@@ -656,7 +670,9 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
         q.unknown_words = rest
     elif cat is None:
         q.unknown_words = rest
-        activity = find_activity(head) if other is None else None
+        # "the bath towels need a wash, where can I put them": the other object is what the
+        # activity handles, not a reason to read none.
+        activity = find_activity(head)
         if activity is not None:
             q.purpose = activity
             _attributes_outside(q, head, activity)
@@ -664,7 +680,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                 # The retriever embeds the instruction next: one batch for both.
                 # The act says the furniture; what it is done for ("before making tea") the room.
                 parts = split_activity(activity) or [activity]
-                act = parts[0]
+                act = _without_modifying_categories(parts[0])
                 # What it is done for says the room: embedded in the same run.
                 match = match_purpose(act, embedder, along=(q.text, *(room_text(p) for p in parts[1:])))
                 best, alts = purpose_categories(match)

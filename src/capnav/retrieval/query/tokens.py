@@ -473,8 +473,8 @@ def _other_object(words: list[str], span: tuple[int, int] | None) -> str | None:
     for n in (3, 2):
         for i in range(max(0, span[1] - n), span[0] + 1):
             gram = " ".join(words[i:i + n])
-            if i + n >= span[1] and gram in _LEX.other:
-                return gram
+            if i + n >= span[1] and (gram in _LEX.other or (gram.endswith("s") and gram[:-1] in _LEX.other)):
+                return gram  # "bath towels": a plural too
     return None
 
 
