@@ -123,8 +123,9 @@ def test_the_activity_reaches_the_furniture_made_for_it(bedroom_and_study: Retri
     assert res.found and res.chosen is not None and res.chosen.id == oid, res.reason
 
 
-@pytest.mark.parametrize(("text", "category"), [("the bath mat", None), ("the bed linen", None), ("the bath", "bathtub"),
-                                              ("the lamp shade", "lamp")])
+@pytest.mark.parametrize(("text", "category"), [
+    ("the bath mat", None), ("the bed linen", None), ("the bath", "bathtub"), ("the lamp shade", "lamp"),
+])
 def test_a_compound_on_a_category_word_names_another_thing(text: str, category: str | None) -> None:
     # WordNet's compounds whose first word is a category word ("bath towel") are another object;
     # a part of the category's object ("lamp shade") is still that object.
