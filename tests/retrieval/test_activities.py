@@ -88,6 +88,7 @@ def test_an_activity_of_any_room_implies_none(emb, activity: str) -> None:  # ty
     ("leave my keys", True), ("leave the phone", True), ("charge my phone", True),
     ("recharge my laptop overnight", True), ("put the towels on a wash cycle", False),
     ("rinse a cup", False), ("leave the kitchen", False), ("read a book", False),
+    ("make a phone call", False), ("charge my phone overnight", True),
 ])
 def test_a_thing_handled_that_no_furniture_is_made_for_is_put_down(emb, activity: str,
                                                                     placing: bool) -> None:  # type: ignore[no-untyped-def]

@@ -238,12 +238,20 @@ HANDLED_MIN = 0.35
 MADE_FOR = 0.45
 
 
+#: Words that may follow the thing handled without naming another thing ("charge my phone
+#: overnight", "... for the night"); any other word makes it a modifier ("a phone call").
+_AFTER_THING = {"for", "on", "in", "at", "by", "near", "next", "beside", "overnight", "tonight", "again", "now", "up",
+                "while", "whilst", "before", "after", "when", "so", "then", "and", "somewhere", "please", "safely"}
+
+
 def _handled(words: list[str]) -> bool:
     """Whether ``words`` name a thing the detector sees that one carries ("phone", "laptop", "mug"):
-    a label of the lexicon, or the last word of one ("mobile phone")."""
+    a label of the lexicon, or the last word of one ("mobile phone"), as the head of its phrase
+    (not "make a [phone] call")."""
     lex = load_lexicon()
     heads = {f.split()[-1] for f in lex.labels}
-    return any(w in lex.labels or w in heads or (w.endswith("s") and w[:-1] in heads) for w in words)
+    return any((w in lex.labels or w in heads or (w.endswith("s") and w[:-1] in heads))
+               and (k + 1 == len(words) or words[k + 1] in _AFTER_THING) for k, w in enumerate(words))
 
 
 def is_placing(activity: str, embedder: TextEmbedder | None = None,
