@@ -212,6 +212,7 @@ def build(wordnet: Path) -> dict[str, Any]:
         out["persons"] = _persons(wn, noun_exc)
         out["kinds"] = _kinds(wn, out["forms"])
         out["placing"] = _placing(wn)
+        out["verb_phrases"] = _verb_phrases(wn)
         out["placing_past"] = _placing_past(out["placing"], (wordnet / "verb.exc").read_text().splitlines())
         out["body"] = _body(wn, noun_exc)
         out["materials"] = _materials(wn, out["forms"], out["labels"])
@@ -449,6 +450,26 @@ def _placing(wn: Any) -> list[str]:
         for s in [wn.synset(n), *wn.synset(n).closure(lambda x: x.hyponyms())]:
             out |= {_form(lem.name()) for lem in s.lemmas()}
     return sorted(f for f in out if f.replace(" ", "").isalpha() and f == f.lower())
+
+
+#: Verbs that carry little meaning of their own in an idiom ("do the dishes", "get dressed").
+LIGHT_VERBS = ("do", "have", "take", "get", "make", "go", "give")
+
+
+def _verb_phrases(wn: Any) -> dict[str, str]:
+    """Idioms of a light verb (``LIGHT_VERBS``) -> the definition of their first sense ("do the
+    dishes": "wash dishes", "get dressed": "put on clothes"), so that an activity said as an idiom
+    is compared with the furniture by what it means. Not other verbs of several words: their
+    own verb carries the meaning, and their first sense is often not the household one ("hang
+    up": a telephone receiver)."""
+    out: dict[str, str] = {}
+    for lemma in wn.all_lemma_names("v"):
+        words = lemma.split("_")
+        if len(words) < 2 or len(words) > 4 or lemma != lemma.lower() or not all(w.isalpha() for w in words) \
+                or words[0] not in LIGHT_VERBS:
+            continue
+        out[" ".join(words)] = wn.synsets(lemma, "v")[0].definition()
+    return dict(sorted(out.items()))
 
 
 def _placing_past(placing: list[str], exceptions: list[str]) -> dict[str, str]:

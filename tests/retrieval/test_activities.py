@@ -10,7 +10,7 @@ from __future__ import annotations
 import pytest
 
 from capnav.language import create_embedder
-from capnav.language.purpose import activity_room, is_placing, split_activity
+from capnav.language.purpose import activity_room, explain_activity, is_placing, split_activity
 from capnav.retrieval import Retriever
 from capnav.retrieval.query import parse_instruction
 from language.synth import grid_with_wall, make_obj, offline_retriever
@@ -95,6 +95,12 @@ def test_a_thing_handled_that_no_furniture_is_made_for_is_put_down(emb, activity
     assert is_placing(activity, emb) is placing
 
 
+def test_an_idiom_of_a_light_verb_is_read_by_what_it_means() -> None:
+    assert explain_activity("do the dishes").endswith("wash dishes")
+    assert explain_activity("doing the dishes").endswith("wash dishes")
+    assert explain_activity("hang up my coat") == "hang up my coat"  # no light verb: its own words
+
+
 # -- end to end on the scenes --------------------------------------------------------------------
 
 @pytest.mark.parametrize(("text", "oid"), [
@@ -104,6 +110,7 @@ def test_a_thing_handled_that_no_furniture_is_made_for_is_put_down(emb, activity
     ("where do I put the laundry on a wash cycle", WASHER),
     ("these sheets need a hot wash, where can I put them on a cycle?", WASHER),
     ("the bath towels need washing, where can I put them on a cycle?", WASHER),
+    ("where can I do the dishes", KITCHEN_SINK),
 ])
 def test_the_activity_reaches_the_furniture_in_its_room(kitchen_and_bathroom: Retriever, text: str,
                                                         oid: int) -> None:

@@ -53,6 +53,8 @@ class Lexicon:
     placing: frozenset[str] = frozenset()
     #: irregular inflections of the placing verbs ("left" leave, "laid" lay; WordNet's verb.exc)
     placing_past: dict[str, str] = field(default_factory=dict)
+    #: a verb of several words -> the definition of its first sense ("do the dishes": "wash dishes")
+    verb_phrases: dict[str, str] = field(default_factory=dict)
     #: nouns for parts of the body, with plurals ("feet": noun.body in WordNet)
     body: frozenset[str] = frozenset()
     #: a material word -> the material the surface test knows ("velvety" velvet, "suede" leather,
@@ -114,7 +116,7 @@ def load_lexicon() -> Lexicon:
                   persons=frozenset(raw.get("persons", [])),
                   kinds={k: tuple(v) for k, v in raw.get("kinds", {}).items()},
                   placing=frozenset(raw.get("placing", [])), body=frozenset(raw.get("body", [])),
-                  placing_past=dict(raw.get("placing_past", {})),
+                  placing_past=dict(raw.get("placing_past", {})), verb_phrases=dict(raw.get("verb_phrases", {})),
                   materials=dict(raw.get("materials", {})), heights=dict(raw.get("heights", {})),
                   height_superlatives=dict(raw.get("height_superlatives", {})),
                   rooms=dict(raw.get("rooms", {})),

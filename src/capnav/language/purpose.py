@@ -107,6 +107,21 @@ def normalise_activity(activity: str) -> str:
     return " ".join(_PERSON.get(w, w) for w in act.split())
 
 
+def explain_activity(activity: str) -> str:
+    """The activity with what its idiom means, when it starts with one of WordNet's light-verb
+    idioms ("do the dishes" -> "do the dishes: wash dishes"; "doing the dishes" too)."""
+    words = activity.split()
+    if not words:
+        return activity
+    phrases = load_lexicon().verb_phrases
+    for verb in _verb_forms(words[0]):
+        for n in (4, 3, 2):
+            gram = " ".join([verb, *words[1:n]])
+            if len(words) >= n and gram in phrases:
+                return f"{activity}: {phrases[gram]}"
+    return activity
+
+
 def find_activity(text: str) -> str | None:
     """The activity of a purpose request, lower case, or None when the text names none."""
     low = text.lower().strip().rstrip("?.!")
@@ -178,7 +193,7 @@ def room_scores(activity: str, embedder: TextEmbedder, config: RoomFitConfig | N
 
 def room_text(activity: str, config: RoomFitConfig | None = None) -> str:
     """The text an activity (or a part of it) is embedded as to say its room."""
-    return (config or RoomFitConfig()).template.format(activity=normalise_activity(activity))
+    return (config or RoomFitConfig()).template.format(activity=explain_activity(normalise_activity(activity)))
 
 
 def activity_room(activity: str, embedder: TextEmbedder, config: RoomFitConfig | None = None) -> str | None:
@@ -380,7 +395,7 @@ class GlossIndex:
         one-shot query's model time."""
         cfg = config or PurposeConfig()
         act = normalise_activity(activity) if cfg.normalise else activity
-        q = self.embedder.embed([cfg.template.format(activity=act), *along])[0]
+        q = self.embedder.embed([cfg.template.format(activity=explain_activity(act)), *along])[0]
         sims = self.E @ q
         per: dict[str, list[float]] = {}
         for cat, s in zip(self.cats, sims[: self.n_glosses], strict=True):
@@ -471,6 +486,6 @@ def purpose_categories(match: PurposeMatch, config: PurposeConfig | None = None)
 
 
 __all__ = ["CACHE_KEY", "HANDLED_MIN", "MADE_FOR", "GlossIndex", "PurposeConfig", "PurposeMatch", "RoomFitConfig",
-           "activity_room", "find_activity", "gloss_index", "is_placing", "match_purpose", "normalise_activity",
+           "activity_room", "explain_activity", "find_activity", "gloss_index", "is_placing", "match_purpose", "normalise_activity",
            "place_adjective", "purpose_categories", "room_scores", "split_activity", "stated_purpose", "surfaces",
            "use_stored_glosses"]
