@@ -486,6 +486,6 @@ def purpose_categories(match: PurposeMatch, config: PurposeConfig | None = None)
 
 
 __all__ = ["CACHE_KEY", "HANDLED_MIN", "MADE_FOR", "GlossIndex", "PurposeConfig", "PurposeMatch", "RoomFitConfig",
-           "activity_room", "explain_activity", "find_activity", "gloss_index", "is_placing", "match_purpose", "normalise_activity",
-           "place_adjective", "purpose_categories", "room_scores", "split_activity", "stated_purpose", "surfaces",
-           "use_stored_glosses"]
+           "activity_room", "explain_activity", "find_activity", "gloss_index", "is_placing", "match_purpose",
+           "normalise_activity", "place_adjective", "purpose_categories", "room_scores", "room_text", "split_activity",
+           "stated_purpose", "surfaces", "use_stored_glosses"]
