@@ -89,6 +89,7 @@ def test_an_activity_of_any_room_implies_none(emb, activity: str) -> None:  # ty
     ("recharge my laptop overnight", True), ("put the towels on a wash cycle", False),
     ("rinse a cup", False), ("leave the kitchen", False), ("read a book", False),
     ("make a phone call", False), ("charge my phone overnight", True),
+    ("my laptop is running low, charge it", True), ("the cat is hungry, feed it", False),
 ])
 def test_a_thing_handled_that_no_furniture_is_made_for_is_put_down(emb, activity: str,
                                                                     placing: bool) -> None:  # type: ignore[no-untyped-def]
@@ -124,6 +125,8 @@ def test_the_activity_reaches_the_furniture_in_its_room(kitchen_and_bathroom: Re
     ("a cosy place to read", ARMCHAIR),
     ("I'd like a comfy spot to curl up with a novel", ARMCHAIR),
     ("somewhere to write my postcards", DESK),
+    ("somewhere comfy to read", ARMCHAIR),
+    ("my laptop is running low, where can I charge it next to where I sleep?", NIGHTSTAND),
 ])
 def test_the_activity_reaches_the_furniture_made_for_it(bedroom_and_study: Retriever, text: str,
                                                         oid: int) -> None:

@@ -149,9 +149,13 @@ _PLACE_WORD = re.compile(r"\b(?:a|some|any)\s+(?P<adj>[a-z]+(?:-[a-z]+)?)\s+(?:l
                          r"|surface)\b")
 
 
+_SOMEWHERE_ADJ = re.compile(r"\b(?:somewhere|someplace|anywhere)\s+(?P<adj>[a-z]+)\s+(?:to|where|for)\b")
+
+
 def place_adjective(text: str) -> str | None:
-    """The adjective said of the place asked for ("a cosy place to read" -> "cosy"), or None."""
-    m = _PLACE_WORD.search(text.lower())
+    """The adjective said of the place asked for ("a cosy place to read", "somewhere comfy to
+    read" -> "cosy", "comfy"), or None."""
+    m = _PLACE_WORD.search(text.lower()) or _SOMEWHERE_ADJ.search(text.lower())
     return m.group("adj") if m else None
 
 
@@ -259,14 +263,14 @@ _AFTER_THING = {"for", "on", "in", "at", "by", "near", "next", "beside", "overni
                 "while", "whilst", "before", "after", "when", "so", "then", "and", "somewhere", "please", "safely"}
 
 
-def _handled(words: list[str]) -> bool:
+def _handled(words: list[str], anywhere: bool = False) -> bool:
     """Whether ``words`` name a thing the detector sees that one carries ("phone", "laptop", "mug"):
     a label of the lexicon, or the last word of one ("mobile phone"), as the head of its phrase
-    (not "make a [phone] call")."""
+    (not "make a [phone] call"), or ``anywhere`` in a clause a pronoun points back at."""
     lex = load_lexicon()
     heads = {f.split()[-1] for f in lex.labels}
     return any((w in lex.labels or w in heads or (w.endswith("s") and w[:-1] in heads))
-               and (k + 1 == len(words) or words[k + 1] in _AFTER_THING) for k, w in enumerate(words))
+               and (anywhere or k + 1 == len(words) or words[k + 1] in _AFTER_THING) for k, w in enumerate(words))
 
 
 def is_placing(activity: str, embedder: TextEmbedder | None = None,
@@ -278,7 +282,8 @@ def is_placing(activity: str, embedder: TextEmbedder | None = None,
     not a category ("put the towels on a wash cycle": a washing, the glosses decide). With the
     activity's fit (``scores``, or computed with ``embedder``), an activity done with a thing one
     carries that no furniture is made for ("charge my phone") puts that thing down too."""
-    words = normalise_activity(activity).split()
+    told, _, said = normalise_activity(activity).rpartition(", ")
+    words = said.split()
     if not words:
         return False
     lex = load_lexicon()
@@ -297,7 +302,9 @@ def is_placing(activity: str, embedder: TextEmbedder | None = None,
         return True
     if scores is None and embedder is not None:
         scores = gloss_index(embedder).scores(activity)
-    if scores and _handled(words[1:]):
+    # "my laptop is running low, charge it": the pronoun stands for the thing the clause before tells of.
+    handled = _handled(words[1:]) or (bool(told) and bool(_BACK.intersection(words)) and _handled(told.split(), True))
+    if scores and handled:
         return max(scores.values()) < HANDLED_MIN
     return False
 
