@@ -40,7 +40,8 @@ is spoken to):
   with one or more toilets": lavatory, lav, privy). Lamps are ``lamp.n.02`` (the
   furniture), not ``lamp.n.01`` (any source of light: torches, searchlights).
 - ``other``: compounds whose last word is a category word but which name something else (a pool
-  table, a toilet seat, a power plant): game, operating, altar and work tables, wheelchairs,
+  table, a toilet seat, a power plant), and two-word compounds whose first word is one ("bath
+  towel", "bed linen": the category says what the thing is for): game, operating, altar and work tables, wheelchairs,
   hospital beds (``EXCLUDE``), and every WordNet noun ending in a category word whose first physical sense
   is outside that category. "the pool table" is then an object CapNav does not know, not a table.
 - ``relations``: for each ordered pair of categories, ``kind_of`` when one's synsets lie under the
@@ -212,11 +213,16 @@ def build(wordnet: Path) -> dict[str, Any]:
         out["persons"] = _persons(wn, noun_exc)
         out["kinds"] = _kinds(wn, out["forms"])
         out["placing"] = _placing(wn)
+        out["verb_phrases"] = _verb_phrases(wn)
+        out["placing_past"] = _placing_past(out["placing"], (wordnet / "verb.exc").read_text().splitlines())
         out["body"] = _body(wn, noun_exc)
         out["materials"], out["material_nouns"] = _materials(wn, out["forms"], out["labels"])
         out["surface_nouns"] = _surface_nouns(wn)
         out["rooms"] = _rooms(wn, out["forms"], noun_exc)
         out["attributes"] = _attributes(wn, out)
+        out["room_glosses"] = _room_glosses(wn)
+        out["gloss_adjectives"] = _gloss_adjectives(wn, out)
+        out["furniture_senses"] = _furniture_senses(wn, out["forms"])
         out["forms"] = dict(sorted(out["forms"].items()))
         return out
 
@@ -433,7 +439,9 @@ def _kinds(wn: Any, forms: dict[str, str]) -> dict[str, list[str]]:
 #: support", "place temporarily"; and, with their hyponyms (plonk, plunk, plump down), "put or
 #: settle into a position" and "cause to ... be in a settled position or place". Not the
 #: hyponyms of the first ones: they bury, sow, bottle and install.
-PLACING_SENSES = ["put.v.01", "lay.v.02", "rest.v.08", "park.v.01"]
+#: ``leave.v.02`` ("go and leave behind, either intentionally or by neglect"): a thing left
+#: somewhere stays where it was left ("she left her bag by the bed", "where can I leave my keys").
+PLACING_SENSES = ["put.v.01", "lay.v.02", "rest.v.08", "park.v.01", "leave.v.02"]
 PLACING_TREES = ["set_down.v.03", "set_down.v.04"]
 
 
@@ -444,6 +452,39 @@ def _placing(wn: Any) -> list[str]:
         for s in [wn.synset(n), *wn.synset(n).closure(lambda x: x.hyponyms())]:
             out |= {_form(lem.name()) for lem in s.lemmas()}
     return sorted(f for f in out if f.replace(" ", "").isalpha() and f == f.lower())
+
+
+#: Verbs that carry little meaning of their own in an idiom ("do the dishes", "get dressed").
+LIGHT_VERBS = ("do", "have", "take", "get", "make", "go", "give")
+
+
+def _verb_phrases(wn: Any) -> dict[str, str]:
+    """Idioms of a light verb (``LIGHT_VERBS``) -> the definition of their first sense ("do the
+    dishes": "wash dishes", "get dressed": "put on clothes"), so that an activity said as an idiom
+    is compared with the furniture by what it means. Not other verbs of several words: their
+    own verb carries the meaning, and their first sense is often not the household one ("hang
+    up": a telephone receiver)."""
+    out: dict[str, str] = {}
+    for lemma in wn.all_lemma_names("v"):
+        words = lemma.split("_")
+        if len(words) < 2 or len(words) > 4 or lemma != lemma.lower() or not all(w.isalpha() for w in words) \
+                or words[0] not in LIGHT_VERBS:
+            continue
+        out[" ".join(words)] = wn.synsets(lemma, "v")[0].definition()
+    return dict(sorted(out.items()))
+
+
+def _placing_past(placing: list[str], exceptions: list[str]) -> dict[str, str]:
+    """Irregular inflections of the placing verbs from WordNet's exception list (``verb.exc``:
+    "left" leave, "laid" lay): "she left her bag by the bed" puts the bag where it was left."""
+    single = {p for p in placing if " " not in p}
+    out: dict[str, str] = {}
+    for line in exceptions:
+        infl, *bases = line.split()
+        base = next((b for b in bases if b in single), None)
+        if base is not None and infl not in single:
+            out[infl] = base
+    return dict(sorted(out.items()))
 
 
 #: The materials the surface test knows (``capnav.language.surface``), each with the WordNet
@@ -925,6 +966,99 @@ def _rooms_of_fixtures(wn: Any) -> dict[str, list[str]]:
     return out
 
 
+def _part(syn: Any, owner: dict[str, str]) -> bool:
+    """Whether ``syn`` or a hypernym of it is a part of a category's object (WordNet's part
+    holonyms: a lampshade of the lamp)."""
+    return any(h.name() in owner for x in [syn, *syn.closure(lambda y: y.hypernyms())] for h in x.part_holonyms())
+
+
+def _room_glosses(wn: Any) -> dict[str, list[str]]:
+    """Room type -> WordNet's definitions of its ``ROOM_ROOTS`` ("a room equipped for preparing
+    meals"), so that an activity can say which room it is done in ("making tea": the kitchen)."""
+    return {room: list(dict.fromkeys(wn.synset(n.rstrip("!")).definition() for n in roots))
+            for room, roots in ROOM_ROOTS.items()}
+
+
+def _gloss_adjectives(wn: Any, lex: dict[str, Any]) -> dict[str, list[str]]:
+    """Adjective -> the categories whose definitions say it, through its first sense: the lemmas
+    of that synset and, for a satellite, of its head ("cosy" -> cozy.s.01, whose head
+    comfortable.a.01 an easy chair's definition says: "a comfortable upholstered armchair"). A
+    place described by one ("a cosy place to read") is that furniture among the ones serving the
+    activity. Words of the size, height, colour, material and attribute tables are left to them."""
+    import re
+
+    def adjective(w: str) -> bool:  # a gloss word used as an adjective first ("comfortable")
+        first = wn.synsets(w)
+        return len(w) > 3 and bool(first) and first[0].pos() in "as"
+
+    def count(w: str, pos: str) -> int:
+        return sum(lem.count() for x in wn.synsets(w, pos) for lem in x.lemmas() if lem.name() == w)
+
+    words = {c: {w for w in re.findall(r"[a-z]+", " ".join(g).lower()) if adjective(w)}
+             for c, g in lex["glosses"].items()}
+    taken = set(lex["sizes"]) | set(lex["heights"]) | set(lex["materials"]) | set(lex["attributes"]) \
+        | set(LEXICON) | set(ALIASES) | set(lex["forms"])
+    out: dict[str, list[str]] = {}
+    for lemma in sorted(set(wn.all_lemma_names("a")) | set(wn.all_lemma_names("s"))):
+        if lemma != lemma.lower() or not lemma.isalpha() or lemma in taken:
+            continue
+        senses = [s for s in wn.synsets(lemma) if s.pos() in "as"]
+        if not senses or wn.synsets(lemma, "v") or count(lemma, "n") > count(lemma, "a"):
+            continue  # "cosy" (a tea cosy too, rarely said) yes, "wash" (a verb too) no
+        near = [senses[0], *(senses[0].similar_tos() if senses[0].pos() == "s" else [])]
+        said = {lem.name().lower() for x in near for lem in x.lemmas()}
+        cats = sorted(c for c, ws in words.items() if said & ws)
+        if cats and len(cats) <= 2:  # a word many definitions say ("small") picks nothing out
+            out[lemma] = cats
+    return out
+
+
+def _furniture_senses(wn: Any, forms: dict[str, str]) -> dict[str, dict[str, Any]]:
+    """Words whose first physical sense is something else but which WordNet also has as a piece
+    of furniture of a category, and only as that one (Irish and British "press": a printing press
+    first, the wardrobe's synonym "clothes press" too): word -> {"category", "synset",
+    "alternatives"}. Read only as the head of a request that names no category otherwise. The
+    alternatives are the categories of the first sense of the synset's other lemmas ("closet":
+    a cupboard, the cabinet). Words with an adjective sense ("lower") or that name a person
+    first ("secretary") are left out."""
+    excluded = {s.name() for n in EXCLUDE for s in wn.synset(n).closure(lambda x: x.hyponyms())} | set(EXCLUDE)
+    members = {cat: _closure(wn, roots, excluded) for cat, roots in ROOTS.items()}
+    owner: dict[str, str] = {}
+    for cat in sorted(members, key=lambda c: len(members[c]), reverse=True):
+        for s in members[cat]:
+            owner[s] = cat
+    furniture = wn.synset("furniture.n.01")
+    found: dict[str, set[str]] = {}
+    for name, cat in sorted(owner.items()):
+        syn = wn.synset(name)
+        if furniture not in syn.closure(lambda x: x.hypernyms()):
+            continue
+        for lem in syn.lemmas():
+            word = lem.name()
+            if word != word.lower() or not word.isalpha() or word in forms or word in ROOM_WORDS:
+                continue
+            nouns = wn.synsets(word, "n")
+            if not nouns or nouns[0].lexname() == "noun.person" or wn.synsets(word, "a") or wn.synsets(word, "s"):
+                continue
+            found.setdefault(word, set()).add(name)
+    out: dict[str, dict[str, Any]] = {}
+    for word, names in sorted(found.items()):
+        cats = {owner[n] for n in names}
+        if len(cats) != 1:
+            continue
+        name = sorted(names)[0]
+        alts: dict[str, float] = {}
+        for lem in wn.synset(name).lemmas():
+            other = lem.name()
+            if other == word:
+                continue
+            first = [x for x in wn.synsets(other, "n") if x.lexname() in PHYSICAL]
+            if first and first[0].name() in owner and owner[first[0].name()] not in cats:
+                alts[owner[first[0].name()]] = 0.5
+        out[word] = {"category": next(iter(cats)), "synset": name, "alternatives": dict(sorted(alts.items()))}
+    return out
+
+
 def _closure(wn: Any, names: list[str], excluded: set[str]) -> set[str]:
     """The synsets and their hyponyms (a name ending in "!" is taken without its hyponyms)."""
     out = {n[:-1] for n in names if n.endswith("!")}
@@ -985,12 +1119,23 @@ def _build(wn: Any) -> dict[str, Any]:
             alternatives[form] = {o: 0.5 for o in sorted(others)}
     # Compounds ending in a category word that are something else.
     heads = {f.split()[-1] for f in forms}
+    # ... and compounds in which a category word names what the object is for ("bath towel",
+    # "bed linen"): the category word modifies another noun.
+    firsts = {f for f in forms if " " not in f}
     other: list[str] = []
     for lemma in wn.all_lemma_names("n"):
         form = _form(lemma)
         words = form.split()
-        if len(words) < 2 or len(words) > 3 or words[-1] not in heads or form in forms or lemma != lemma.lower():
+        if len(words) < 2 or len(words) > 3 or form in forms or lemma != lemma.lower():
             continue
+        first_word = words[-1] not in heads
+        if first_word and not (len(words) == 2 and words[0] in firsts and words[1] not in firsts):
+            continue
+        if first_word:
+            # Not a part of the object ("lamp shade", "toilet seat": the lamp, the toilet) nor a room.
+            sense = next(iter(physical_senses(lemma)), None)
+            if sense is None or sense.lexname() != "noun.artifact" or _part(sense, owner) or words[1] in ROOM_WORDS:
+                continue
         senses = physical_senses(lemma)
         if senses and senses[0].name() not in owner:
             other.append(form)

@@ -51,6 +51,10 @@ class Lexicon:
     kinds: dict[str, tuple[str, ...]] = field(default_factory=dict)
     #: verbs of putting a thing down on a support ("put", "set down", "rest", "plonk")
     placing: frozenset[str] = frozenset()
+    #: irregular inflections of the placing verbs ("left" leave, "laid" lay; WordNet's verb.exc)
+    placing_past: dict[str, str] = field(default_factory=dict)
+    #: a verb of several words -> the definition of its first sense ("do the dishes": "wash dishes")
+    verb_phrases: dict[str, str] = field(default_factory=dict)
     #: nouns for parts of the body, with plurals ("feet": noun.body in WordNet)
     body: frozenset[str] = frozenset()
     #: a material word -> the material the surface test knows ("velvety" velvet, "suede" leather,
@@ -71,6 +75,15 @@ class Lexicon:
     #: "boxy" (shape, rectangular, gloss), "see-through" (material, glass, definition), "azure"
     #: (colour, blue, hypernym), "squishy" (unobserved, soft, similar_to); see build_lexicon
     attributes: dict[str, tuple[str, str, str]] = field(default_factory=dict)
+    #: room type -> WordNet's definitions of it ("a room equipped for preparing meals"): the room
+    #: an activity implies ("making tea": the kitchen; ``capnav.language.purpose.activity_room``)
+    room_glosses: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    #: an adjective -> the categories whose definitions say it through its first sense ("cosy":
+    #: comfortable, "a comfortable upholstered armchair"): what a place described by it is
+    gloss_adjectives: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    #: a word whose first sense is something else but which WordNet also has as one category's
+    #: furniture ("press": the wardrobe's "clothes press") -> {"category", "synset", "alternatives"}
+    furniture_senses: dict[str, dict[str, Any]] = field(default_factory=dict)
     load_seconds: float = 0.0
 
     def category_alternatives(self, category: str, form: str | None = None) -> dict[str, float]:
@@ -108,12 +121,16 @@ def load_lexicon() -> Lexicon:
                   persons=frozenset(raw.get("persons", [])),
                   kinds={k: tuple(v) for k, v in raw.get("kinds", {}).items()},
                   placing=frozenset(raw.get("placing", [])), body=frozenset(raw.get("body", [])),
+                  placing_past=dict(raw.get("placing_past", {})), verb_phrases=dict(raw.get("verb_phrases", {})),
                   materials=dict(raw.get("materials", {})), material_nouns=dict(raw.get("material_nouns", {})),
                   surface_nouns=frozenset(raw.get("surface_nouns", [])),
                   heights=dict(raw.get("heights", {})),
                   height_superlatives=dict(raw.get("height_superlatives", {})),
                   rooms=dict(raw.get("rooms", {})),
-                  attributes={k: (v[0], v[1], v[2]) for k, v in raw.get("attributes", {}).items()})
+                  attributes={k: (v[0], v[1], v[2]) for k, v in raw.get("attributes", {}).items()},
+                  room_glosses={k: tuple(v) for k, v in raw.get("room_glosses", {}).items()},
+                  gloss_adjectives={k: tuple(v) for k, v in raw.get("gloss_adjectives", {}).items()},
+                  furniture_senses=dict(raw.get("furniture_senses", {})))
     object.__setattr__(lex, "load_seconds", time.perf_counter() - t0)
     return lex
 

@@ -39,7 +39,8 @@ from capnav.language.lexicon import Lexicon, load_lexicon
 #: A purpose clause: "somewhere (comfy) to X", "a place where I can X", "where can I X",
 #: "I need to X", "something to X on". The activity is group ``act``.
 _PURPOSE = [
-    re.compile(r"\b(?:somewhere|someplace|some place|anywhere|a place|a spot|a surface|something|anything|a thing)"
+    re.compile(r"\b(?:somewhere|someplace|some place|anywhere|(?:a|some)(?:\s+(?!to\b|for\b|where\b)\w+)?\s+"
+               r"(?:place|spot|surface|nook|corner)|something|anything|a thing)"
                r"(?:\s+\w+)?\s+(?:where\s+)?(?:(?:i|we|you|one)\s+(?:can|could|might|may)|to|for\s+(?:me\s+)?to"
                r"|for|that\s+i\s+can)\s+(?P<act>.+)"),
     re.compile(r"\bwhere\s+(?:can|could|do|should|might|would|may)\s+(?:i|we|one|you|(?:the|my|our|your|his|her|"
@@ -106,6 +107,21 @@ def normalise_activity(activity: str) -> str:
     return " ".join(_PERSON.get(w, w) for w in act.split())
 
 
+def explain_activity(activity: str) -> str:
+    """The activity with what its idiom means, when it starts with one of WordNet's light-verb
+    idioms ("do the dishes" -> "do the dishes: wash dishes"; "doing the dishes" too)."""
+    words = activity.split()
+    if not words:
+        return activity
+    phrases = load_lexicon().verb_phrases
+    for verb in _verb_forms(words[0]):
+        for n in (4, 3, 2):
+            gram = " ".join([verb, *words[1:n]])
+            if len(words) >= n and gram in phrases:
+                return f"{activity}: {phrases[gram]}"
+    return activity
+
+
 def find_activity(text: str) -> str | None:
     """The activity of a purpose request, lower case, or None when the text names none."""
     low = text.lower().strip().rstrip("?.!")
@@ -124,8 +140,92 @@ def find_activity(text: str) -> str | None:
             act = re.sub(r"^(?:please|just|quickly)\s+", "", act)
             act = re.sub(r"\s+(?:right|just|somewhere|anywhere)$", "", act)  # "... right next to the bed"
             if act and act not in _PLACEHOLDERS:
-                return act
+                return _with_antecedent(act, low[: m.start()])
+
     return None
+
+
+_PLACE_WORD = re.compile(r"\b(?:a|some|any)\s+(?P<adj>[a-z]+(?:-[a-z]+)?)\s+(?:little\s+)?(?:place|spot|nook|corner"
+                         r"|surface)\b")
+
+
+_SOMEWHERE_ADJ = re.compile(r"\b(?:somewhere|someplace|anywhere)\s+(?P<adj>[a-z]+)\s+(?:to|where|for)\b")
+
+
+def place_adjective(text: str) -> str | None:
+    """The adjective said of the place asked for ("a cosy place to read", "somewhere comfy to
+    read" -> "cosy", "comfy"), or None."""
+    m = _PLACE_WORD.search(text.lower()) or _SOMEWHERE_ADJ.search(text.lower())
+    return m.group("adj") if m else None
+
+
+#: What an activity is done for, after the act itself: "rinse a cup [before making tea]".
+_FOR_WHAT = re.compile(r"\s+(?:before|after|while|whilst|once|until|so\s+that|so|when|then|and\s+then)\s+")
+
+
+def split_activity(activity: str) -> list[str]:
+    """The act and what it is done for, in order ("rinse a cup before making tea" -> "rinse a cup",
+    "making tea"): the act says the furniture, and either may say the room."""
+    return [p.strip() for p in _FOR_WHAT.split(activity.strip()) if p.strip()]
+
+
+@dataclass(frozen=True)
+class RoomFitConfig:
+    template: str = "a place where you can {activity}"
+    #: The best room's cosine must lead the next by this much for the activity to imply it. 0.05
+    #: on the activities of tests/retrieval/test_activities.py: the kitchen and bathroom ones lead
+    #: by 0.06-0.37, the ones done in any room ("keep my socks", "put my drink down") by 0.04 or
+    #: less.
+    margin: float = 0.05
+    min_score: float = 0.3
+
+
+def room_scores(activity: str, embedder: TextEmbedder, config: RoomFitConfig | None = None) -> dict[str, float]:
+    """Room type -> cosine of the activity (in the purpose template) to WordNet's definitions of
+    the room (the best of them), best first."""
+    cfg = config or RoomFitConfig()
+    idx = gloss_index(embedder)
+    rooms, E = idx.room_names, idx.room_E
+    if not rooms:
+        return {}
+    q = embedder.embed([room_text(activity, cfg)])[0]
+    out: dict[str, float] = {}
+    for r, v in zip(rooms, E @ q, strict=True):
+        out[r] = max(out.get(r, -1.0), float(v))
+    return dict(sorted(out.items(), key=lambda kv: -kv[1]))
+
+
+def room_text(activity: str, config: RoomFitConfig | None = None) -> str:
+    """The text an activity (or a part of it) is embedded as to say its room."""
+    return (config or RoomFitConfig()).template.format(activity=explain_activity(normalise_activity(activity)))
+
+
+def activity_room(activity: str, embedder: TextEmbedder, config: RoomFitConfig | None = None) -> str | None:
+    """The room an activity implies, or None when it could be done in several: each part of the
+    activity (``split_activity``) is compared with WordNet's definitions of the rooms; what it is
+    done for speaks first ("rinse a cup before making tea": the tea says the kitchen, although
+    rinsing alone would be the bathroom's as much), then the act."""
+    cfg = config or RoomFitConfig()
+    parts = split_activity(activity)
+    for part in [*parts[1:][::-1], parts[0]] if parts else []:
+        sc = list(room_scores(part, embedder, cfg).items())
+        if len(sc) >= 2 and sc[0][1] >= cfg.min_score and sc[0][1] - sc[1][1] >= cfg.margin:
+            return sc[0][0]
+    return None
+
+
+#: Pronouns that stand for a thing named before the purpose clause.
+_BACK = {"it", "them", "these", "those", "they"}
+
+
+def _with_antecedent(act: str, before: str) -> str:
+    """"these sheets need a hot wash, where can I put them on a cycle": the activity's pronoun
+    stands for what the clause before it tells about, so that clause is part of the activity
+    ("these sheets need a hot wash, put them on a cycle")."""
+    before = before.strip(" ,;.")
+    if not _BACK.intersection(act.split()) or len(before.split()) < 2:
+        return act
+    return f"{before}, {act}"
 
 
 #: Words after a placing verb that put the thing away or inside it: storage, not a surface
@@ -145,18 +245,68 @@ def _verb_forms(word: str) -> list[str]:
     return out
 
 
-def is_placing(activity: str) -> bool:
+#: Prepositions that say where a thing is put ("put the towels [on] a wash cycle").
+_PLACE_PREPS = {"on", "onto", "in", "into", "under", "through"}
+#: Below this best fit no furniture is made for an activity done with a thing handled ("charge my
+#: phone" 0.24, "recharge my laptop" 0.29), so the thing is put down somewhere; furniture made
+#: for such activities reaches 0.45 ("rinse a cup", "read a book"): tests/retrieval/test_activities.py.
+HANDLED_MIN = 0.35
+#: From this best fit up some furniture is made for the activity ("sleep": the bed, "rinse a cup":
+#: the sink, 0.45 and more); below it the furniture only allows it ("read": a lamp 0.39), and a
+#: place said with an adjective ("a cosy place to read") is the furniture the adjective describes.
+MADE_FOR = 0.45
+
+
+#: Words that may follow the thing handled without naming another thing ("charge my phone
+#: overnight", "... for the night"); any other word makes it a modifier ("a phone call").
+_AFTER_THING = {"for", "on", "in", "at", "by", "near", "next", "beside", "overnight", "tonight", "again", "now", "up",
+                "while", "whilst", "before", "after", "when", "so", "then", "and", "somewhere", "please", "safely"}
+
+
+def _handled(words: list[str], anywhere: bool = False) -> bool:
+    """Whether ``words`` name a thing the detector sees that one carries ("phone", "laptop", "mug"):
+    a label of the lexicon, or the last word of one ("mobile phone"), as the head of its phrase
+    (not "make a [phone] call"), or ``anywhere`` in a clause a pronoun points back at."""
+    lex = load_lexicon()
+    heads = {f.split()[-1] for f in lex.labels}
+    return any((w in lex.labels or w in heads or (w.endswith("s") and w[:-1] in heads))
+               and (anywhere or k + 1 == len(words) or words[k + 1] in _AFTER_THING) for k, w in enumerate(words))
+
+
+def is_placing(activity: str, embedder: TextEmbedder | None = None,
+               scores: dict[str, float] | None = None) -> bool:
     """Whether the activity puts a thing down on a support ("rest my cup", "set down a book",
-    "plonk my keys"): its verb is one of the lexicon's placing verbs (WordNet's), the thing is no
-    part of the speaker's body ("rest my feet" rests the person), and nothing puts it away."""
-    words = normalise_activity(activity).split()
+    "plonk my keys", "leave my glasses"): its verb is one of the lexicon's placing verbs
+    (WordNet's), the thing is no part of the speaker's body ("rest my feet" rests the person) nor a
+    room ("leave the kitchen"), nothing puts it away, and the place it is put is no thing that is
+    not a category ("put the towels on a wash cycle": a washing, the glosses decide). With the
+    activity's fit (``scores``, or computed with ``embedder``), an activity done with a thing one
+    carries that no furniture is made for ("charge my phone") puts that thing down too."""
+    told, _, said = normalise_activity(activity).rpartition(", ")
+    words = said.split()
     if not words:
         return False
     lex = load_lexicon()
-    if not any(v in lex.placing or f"{v} {words[1] if len(words) > 1 else ''}".strip() in lex.placing
-               for v in _verb_forms(words[0])):
-        return False
-    return not any(w in _AWAY or w in lex.body for w in words[1:])
+    rooms = {w for r in lex.rooms for w in r.split()} | {"kitchen", "bedroom", "bathroom", "room", "office",
+                                                         "hall", "hallway", "lounge", "house", "flat", "home"}
+    verbs = [*_verb_forms(words[0]), *([lex.placing_past[words[0]]] if words[0] in lex.placing_past else [])]
+    if any(v in lex.placing or f"{v} {words[1] if len(words) > 1 else ''}".strip() in lex.placing for v in verbs):
+        if any(w in _AWAY or w in lex.body or w in rooms for w in words[1:]):
+            return False
+        k = next((i for i, w in enumerate(words[1:], 1) if w in _PLACE_PREPS), None)
+        if k is not None:
+            place = [w for w in words[k + 1:] if w not in ("a", "an", "the", "your", "some")]
+            if place and not any(" ".join(place[i:]) in lex.forms or place[i] in lex.forms
+                                 for i in range(len(place))):
+                return False
+        return True
+    if scores is None and embedder is not None:
+        scores = gloss_index(embedder).scores(activity)
+    # "my laptop is running low, charge it": the pronoun stands for the thing the clause before tells of.
+    handled = _handled(words[1:]) or (bool(told) and bool(_BACK.intersection(words)) and _handled(told.split(), True))
+    if scores and handled:
+        return max(scores.values()) < HANDLED_MIN
+    return False
 
 
 def surfaces(lexicon: Lexicon | None = None) -> list[str]:
@@ -220,12 +370,16 @@ class GlossIndex:
         E = _decode(stored, self.digest, (len(texts), embedder.dim)) if stored else None
         block = stored.get("stated") if stored else None
         S = _decode(block, self.stated_digest, (len(said), embedder.dim)) if isinstance(block, dict) else None
-        todo = ([] if E is not None else texts) + ([] if S is not None else said)
+        # The rooms' definitions (``activity_room``) are few: embedded with whatever else is run.
+        self.room_names = [r for r, gl in lex.room_glosses.items() for _ in gl]
+        rooms = [f"{r}: {g}" for r, gl in lex.room_glosses.items() for g in gl]
+        todo = ([] if E is not None else texts) + ([] if S is not None else said) + rooms
         new = embedder.embed(todo) if todo else np.zeros((0, embedder.dim), np.float32)
         if E is None:
             E, new = new[: len(texts)], new[len(texts):]
         if S is None:
-            S = new[: len(said)]
+            S, new = new[: len(said)], new[len(said):]
+        self.room_E: NDArray[np.float32] = np.asarray(new[: len(rooms)], dtype=np.float32)
         self.E: NDArray[np.float32] = np.vstack([E, S]).astype(np.float32) if len(S) else E
 
     def to_store(self) -> dict[str, Any]:
@@ -248,7 +402,7 @@ class GlossIndex:
         one-shot query's model time."""
         cfg = config or PurposeConfig()
         act = normalise_activity(activity) if cfg.normalise else activity
-        q = self.embedder.embed([cfg.template.format(activity=act), *along])[0]
+        q = self.embedder.embed([cfg.template.format(activity=explain_activity(act)), *along])[0]
         sims = self.E @ q
         per: dict[str, list[float]] = {}
         for cat, s in zip(self.cats, sims[: self.n_glosses], strict=True):
@@ -319,7 +473,7 @@ def purpose_categories(match: PurposeMatch, config: PurposeConfig | None = None)
     score, weighted by their score relative to the best."""
     cfg = config or PurposeConfig()
     items = list(match.scores.items())
-    if is_placing(match.activity):
+    if is_placing(match.activity, scores=match.scores):
         # Any surface serves a thing put down: the scores only order them ("my laptop": a desk).
         keep = set(surfaces())
         items = [(c, v) for c, v in items if c in keep]
@@ -338,6 +492,7 @@ def purpose_categories(match: PurposeMatch, config: PurposeConfig | None = None)
     return best_cat, alts
 
 
-__all__ = ["CACHE_KEY", "GlossIndex", "PurposeConfig", "PurposeMatch", "find_activity", "gloss_index", "is_placing",
-           "match_purpose", "normalise_activity", "purpose_categories", "stated_purpose", "surfaces",
-           "use_stored_glosses"]
+__all__ = ["CACHE_KEY", "HANDLED_MIN", "MADE_FOR", "GlossIndex", "PurposeConfig", "PurposeMatch", "RoomFitConfig",
+           "activity_room", "explain_activity", "find_activity", "gloss_index", "is_placing", "match_purpose",
+           "normalise_activity", "place_adjective", "purpose_categories", "room_scores", "room_text", "split_activity",
+           "stated_purpose", "surfaces", "use_stored_glosses"]

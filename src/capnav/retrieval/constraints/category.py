@@ -81,7 +81,8 @@ class Category(RankingConstraint):
 def stand_ins(q: ParsedQuery) -> set[str]:
     """Categories that may answer for the named one when the map has none of it: its hyponyms in
     the lexicon (``kind_of``), and the other senses of a word of the request (a commode may be a
-    dresser). Not the more general categories, nor siblings: "the desk" is never the table.
+    dresser; a press, read as WordNet's wardrobe, may be the cupboard its synonym "closet" is).
+    Not the more general categories, nor siblings: "the desk" is never the table.
 
     The category table wins over WordNet's tree where they disagree: WordNet files "settee" under
     "bench", but the table makes settee a sofa, and "bench" names no category, so no sofa (nor a
@@ -94,6 +95,12 @@ def stand_ins(q: ParsedQuery) -> set[str]:
     for n in (1, 2, 3):
         for k in range(len(words) - n + 1):
             out |= set(lex.form_alternatives.get(" ".join(words[k:k + n]), {}))
+    for w in q.text.lower().split():
+        # "the kitchen press": a word read by its one furniture sense (the wardrobe) may be what
+        # its synonym's first sense is ("closet": the cupboard).
+        sense = next((lex.furniture_senses[f] for f in (w, w[:-1], w[:-2]) if f in lex.furniture_senses), None)
+        if sense is not None and sense["category"] == q.category:
+            out |= set(sense.get("alternatives", {}))
     return {canonical_label(c) for c in out}
 
 

@@ -144,7 +144,7 @@ class Relation(RankingConstraint):
                 st.notes.append(f"'{q.relation}' needs a viewpoint (a robot position): ordered by the gap "
                                 f"to the {q.anchor_category} alone")
             key = np.round(gap / BIN_M)  # quarter-metre bins, attributes break ties
-            if q.purpose is not None and is_placing(q.purpose):
+            if q.purpose is not None and (q.placing or is_placing(q.purpose)):
                 # "somewhere by the bed to put my glass": every surface serves a thing put down,
                 # so the landmark chooses among them before their order of fit (after a room).
                 # Other purposes keep their order of fit first: their runners-up may merely allow

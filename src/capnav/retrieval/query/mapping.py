@@ -14,7 +14,18 @@ from typing import TYPE_CHECKING
 from capnav.core.categories import BY_NAME
 from capnav.language.colors import ALIASES, LEXICON
 from capnav.language.context import ROOM_SYNONYMS
-from capnav.language.purpose import find_activity, is_placing, match_purpose, purpose_categories
+from capnav.language.purpose import (
+    MADE_FOR,
+    PurposeConfig,
+    activity_room,
+    find_activity,
+    is_placing,
+    match_purpose,
+    place_adjective,
+    purpose_categories,
+    room_text,
+    split_activity,
+)
 from capnav.retrieval.query.count import read_count, without
 from capnav.retrieval.query.model import ACROSS, BETWEEN, ROOM_WITH, ParsedQuery
 from capnav.retrieval.query.parse import _GENERIC, ROOM_ALONG, GoalParse, describe, passed_object
@@ -291,7 +302,7 @@ def _put_down(words: list[str]) -> bool:
     WordNet's, in any inflection; ``is_placing`` reads -ing and -s, the past tense is tried here):
     what follows "on" is where it was put."""
     for i, w in enumerate(words):
-        past = [w[:-1], w[:-2]] if w.endswith("ed") else []
+        past = [w[:-1], w[:-2]] if w.endswith("ed") else [_LEX.placing_past[w]] if w in _LEX.placing_past else []
         if is_placing(" ".join(words[i:i + 2])) or any(is_placing(stem) for stem in past):
             return True
     return False
@@ -564,6 +575,41 @@ def _count(q: ParsedQuery, head: str) -> str:
     return without(head, c.spans)
 
 
+def _without_modifying_categories(act: str) -> str:
+    """The activity without a category word that only says what another thing handled is for
+    ("put the bath towels on a cycle" -> "put the towels on a cycle"): WordNet's compound names
+    the towel, and its "bath" is no furniture the activity asks for."""
+    words = act.split()
+    out = []
+    for k, w in enumerate(words):
+        nxt = " ".join(words[k:k + 2])
+        if k + 1 < len(words) and w in _LEX.forms and (nxt in _LEX.other or nxt[:-1] in _LEX.other):
+            continue
+        out.append(w)
+    return " ".join(out) or act
+
+
+def _described_place(q: ParsedQuery, head: str, best: str | None, alts: dict[str, float],
+                     scores: dict[str, float]) -> tuple[str | None, dict[str, float]]:
+    """"a cosy place to read": the adjective said of the place is what the furniture's own
+    definitions say (WordNet: cosy is comfortable, "a comfortable upholstered armchair"), so of
+    the categories that serve the activity (within the purpose margin of the best fit, however
+    many there are) the ones it describes come first; when no furniture is made for the activity
+    (its best fit below ``MADE_FOR``), the furniture the adjective describes is the place."""
+    adj = place_adjective(head)
+    said = _LEX.gloss_adjectives.get(adj or "", ())
+    top = scores.get(best or "", 0.0)
+    fit = [c for c in said if c == best or c in alts or scores.get(c, -1.0) >= top - PurposeConfig().margin]
+    if not fit and top < MADE_FOR:
+        fit = list(said)  # nothing is made for the activity ("read": a lamp allows it): the place as described
+    if best is None or not fit or fit[0] == best:
+        return best, alts
+    new = fit[0]
+    out = {best: round(min(0.95, alts.get(new, 0.95)), 3), **{c: w for c, w in alts.items() if c != new}}
+    q.notes.append(f"'{adj}' place: WordNet's definitions say it of the {new}, which serves '{q.purpose}' too")
+    return new, dict(sorted(out.items(), key=lambda kv: -kv[1]))
+
+
 def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     """Read ``text``. With ``embedder`` (the retriever's), a request by purpose ("somewhere to
     sit") is mapped to categories through the lexicon's glosses; without one it keeps ``purpose``
@@ -644,7 +690,8 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     if q.anchor_category is None:
         for rel in _RELATIONS:
             m = re.search(rf"\b{rel}\s+(?:the\s+|a\s+|an\s+|my\s+)?(.+)$", head) if rel in head else None
-            if m and rel == "on" and _put_down(head[:m.start()].split()):
+            if m and rel == "on" and _put_down(head[:m.start()].split()) \
+                    and _find_category(m.group(1).split())[0] is not None:
                 head = m.group(1)  # "I put my mug down on the counter": where it was put is the goal
                 break
             if m and rel == "on" and _find_category(head[:m.start()].split())[0] is None:
@@ -658,6 +705,13 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                     q.relation = "next to" if rel in ("besides", "beside", "by", "close to", "alongside") else rel
                     q.anchor_category, q.anchor_phrase = stand_in[0], stand_in[1]
                     head = head[: m.start()]
+                    break
+                before = head[:m.start()].split()
+                if cat is not None and _put_down(before) and _find_category(before)[0] is None:
+                    # "she left her bag by the bed, go there": a thing the map does not hold was
+                    # left or put by the landmark; where it was left is the goal.
+                    q.notes.append(f"where it was put ({rel} the {cat}) is the goal")
+                    head = m.group(1)
                     break
                 if cat is not None and _verb_only(head[:m.start()]):
                     # "swing by the fridge", "pop by the stove": a verb of going with its
@@ -717,6 +771,14 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     if cat is not None and span is not None:
         form = " ".join(words[span[0]:span[1]])
         q.category_alternatives = _LEX.category_alternatives(cat, None if fuzzy else form)
+        sense = next((_LEX.furniture_senses[f] for f in (form, form[:-1], form[:-2]) if f in _LEX.furniture_senses),
+                     None)
+        if sense is not None and _LEX.forms.get(form) is None:
+            # "the kitchen press": WordNet's one furniture sense of a word that is first another thing.
+            for other, w in dict(sense.get("alternatives", {})).items():
+                q.category_alternatives[other] = max(q.category_alternatives.get(other, 0.0), float(w))
+            q.notes.append(f"'{form}' is read as the {cat}: its only furniture sense in WordNet "
+                           f"({sense['synset']}); its first sense is another thing")
         if cat in _LEX.kinds:
             # "the appliance on your left": every category of the kind is the named one.
             q.category, q.category_alternatives = None, dict.fromkeys(_LEX.kinds[cat], 1.0)
@@ -731,13 +793,22 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
         q.unknown_words = rest
     elif cat is None:
         q.unknown_words = rest
-        activity = find_activity(head) if other is None else None
+        # "the bath towels need a wash, where can I put them": the other object is what the
+        # activity handles, not a reason to read none.
+        activity = find_activity(head)
         if activity is not None:
             q.purpose = activity
             _attributes_outside(q, head, activity)
             if embedder is not None:
                 # The retriever embeds the instruction next: one batch for both.
-                best, alts = purpose_categories(match_purpose(activity, embedder, along=(q.text,)))
+                # The act says the furniture; what it is done for ("before making tea") the room.
+                parts = split_activity(activity) or [activity]
+                act = _without_modifying_categories(parts[0])
+                # What it is done for says the room: embedded in the same run.
+                match = match_purpose(act, embedder, along=(q.text, *(room_text(p) for p in parts[1:])))
+                best, alts = purpose_categories(match)
+                q.placing = is_placing(act, scores=match.scores)
+                best, alts = _described_place(q, head, best, alts, match.scores)
                 if best is not None:
                     # The lexicon's relatives of each category that serves (a stool beside a chair),
                     # weighted below it: a room or a landmark can then choose among them.
@@ -746,10 +817,16 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                             if other != best:
                                 alts[other] = max(alts.get(other, 0.0), round(wt * w2, 3))
                     q.category, q.category_alternatives, q.unknown_words = best, alts, []
+                    q.purpose_room = activity_room(activity, embedder)
     else:
         q.unknown_words = rest
     if q.category is None and q.purpose is None and any(w in _GENERIC for w in words):
         q.generic, q.unknown_words = True, []
+    if q.category is None and q.purpose is None and not q.generic and not q.category_alternatives and rest:
+        # "where's the dunny": a name neither WordNet nor the category table has; said plainly, and
+        # never answered by a lookalike word ("khaki").
+        q.notes.append(f"no object word here is known to the lexicon (WordNet 3.0 and the category table): "
+                       f"{rest[-1]!r}")
     desc = list(dict.fromkeys(w for part in (*q.colors, *q.materials, *q.shapes) for w in part.split()))
     noun = q.category if q.category is not None else cat if cat is not None else " ".join(rest[-2:]) if rest else ""
     q.target_phrase = " ".join([*desc, noun]).strip() or norm

@@ -36,6 +36,12 @@ class ParsedQuery:
     #: be served by an armchair or a stool, ranked below chairs; a purpose maps to several).
     category_alternatives: dict[str, float] = field(default_factory=dict)
     purpose: str | None = None  # the request named a use ("somewhere to sit"), not an object
+    #: The room the purpose implies ("rinse a cup before making tea": the kitchen): a preference
+    #: among the instances of the category that serves it, never a refusal (``purpose.activity_room``).
+    purpose_room: str | None = None
+    #: The purpose puts a thing down ("somewhere to charge my phone"): every surface serves it, and a
+    #: landmark chooses among them (``purpose.is_placing``).
+    placing: bool = False
     negations: list[str] = field(default_factory=list)  # phrases the target must NOT match ("white")
     ordinal: int | None = None  # 2 for "the second closest"
     proximity_to_anchor: bool = False  # "the stool nearest the stove": distance to the anchor

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 from capnav.core.errors import pip_hint
 from capnav.language.context import rooms_starting
+from capnav.language.lexicon import load_lexicon
 from capnav.language.purpose import find_activity
 from capnav.retrieval.query.count import DOORS
 from capnav.retrieval.query.tokens import _FORM_MAP, _find_category, attribute_word
@@ -412,6 +413,41 @@ def _back_references(doc: Doc, ask: set[int], mentions: list[tuple[int, int, str
             if doc[i].lower_ in _BACK_REFERENCES and doc[i].pos_ == "PRON" and doc[i].dep_ == "pobj"}
 
 
+def _placing_verb(t: Token) -> bool:
+    """Whether ``t`` is one of the lexicon's placing verbs in any inflection ("put", "left", "laid")."""
+    lex = load_lexicon()
+    w = t.lower_
+    return t.pos_ in ("VERB", "AUX") and ((t.lemma_ or w).lower() in lex.placing or w in lex.placing
+                                          or w in lex.placing_past)
+
+
+def _placed_pronoun(doc: Doc, ask: set[int], mentions: list[tuple[int, int, str]]) -> set[int]:
+    """"we bought a plant and put it next to the fridge, go look at it": the place the ask points
+    at is where a placing verb put a pronoun; the verb and its pronoun go with the place, so that
+    the pronoun can stand for the object it points back at (``_placed_references``)."""
+    out: set[int] = set()
+    for t in doc:
+        v = doc[_clause_verb(t)] if t.i in ask and t.dep_ == "pobj" else None
+        if v is not None and v.i not in ask and _placing_verb(v):
+            obj = [c for c in v.children if c.dep_ == "dobj" and c.lower_ in _BACK_REFERENCES]
+            if obj and any(m[1] <= obj[0].i for m in mentions):
+                out |= {v.i, obj[0].i} | {x.i for x in v.subtree if obj[0].i < x.i < t.i}
+    return out
+
+
+def _placed_references(doc: Doc, ask: set[int], mentions: list[tuple[int, int, str]]) -> dict[int, str]:
+    """A pronoun put somewhere by a placing verb of the ask ("put [it] next to the fridge") -> the
+    object named last before it ("a new plant"), which it stands for."""
+    out: dict[int, str] = {}
+    for t in doc:
+        if t.i in ask and t.dep_ == "dobj" and t.lower_ in _BACK_REFERENCES and _placing_verb(t.head):
+            before = [m for m in mentions if m[1] <= t.i and m[0] not in ask]
+            if before:
+                s, e, _ = before[-1]
+                out[t.i] = "the " + doc[s:e].text
+    return out
+
+
 #: Modal verbs of a polite request put as a question ("could you roll over", "would you pop by").
 _ASK_MODALS = {"could", "can", "would", "will"}
 #: Dependencies of a verb that is no clause of its own (an infinitive, a participle as a modifier).
@@ -509,7 +545,9 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
     ask = _request_clause(doc, mentions)
     refs: dict[int, str] = {}
     if ask is not None:
+        ask |= _placed_pronoun(doc, ask, mentions)
         refs = _back_references(doc, ask, mentions)
+        refs.update(_placed_references(doc, ask, mentions))
         mentions = [m for m in mentions if m[0] in ask]
         g.notes.append("read the request's own clause: " + doc[min(ask):max(ask) + 1].text)
     # A story's room is where it happens ("... in the kitchen, so take me to the plant in there").

@@ -253,7 +253,28 @@ def _find_category(words: list[str]) -> tuple[str | None, tuple[int, int] | None
         # ... and a class's exact name right after a typo read ("the stone bench": a bench).
         label = _find_label(words[span[1]:], 1)
         label = None if label is None else (label[0], (span[1] + label[1][0], span[1] + label[1][1]), False)
+    if label is None and cat is None:
+        return furniture_sense(words)
     return label if label is not None else (cat, span, fuzzy)
+
+
+_DET = {"the", "a", "an", "my", "our", "your", "his", "her", "their", "this", "that", "these", "those"}
+
+
+def furniture_sense(words: list[str]) -> tuple[str | None, tuple[int, int] | None, bool]:
+    """A word WordNet has as one category's furniture although its first sense is another thing
+    ("the kitchen press": the wardrobe's "clothes press"), read only where an object's name
+    stands (within two words after a determiner, not before "of") in words that name no
+    category otherwise; (None, None, False) when there is none."""
+    for k, w in enumerate(words):
+        base = w if w in _LEX.furniture_senses else w[:-2] if w.endswith("es") and w[:-2] in _LEX.furniture_senses \
+            else w[:-1] if w.endswith("s") and w[:-1] in _LEX.furniture_senses else None
+        if base is None or not any(x in _DET for x in words[max(0, k - 2):k]):
+            continue
+        if k + 1 < len(words) and words[k + 1] in ("of", "to", "up", "down", "on", "off"):
+            continue
+        return str(_LEX.furniture_senses[base]["category"]), (k, k + 1), False
+    return None, None, False
 
 
 def _exact_at(words: list[str], i: int) -> tuple[str, tuple[int, int]] | None:
@@ -375,13 +396,31 @@ _SHORT_KEYWORDS = sorted({w for w in ("next", "near", "hall", "room", "front", "
                           if len(w) in (4, 5) and w.isalpha()})
 
 
+_DETERMINERS = {"the", "a", "an", "my", "our", "your", "his", "her", "their", "this", "that"}
+
+
+def _noun_place(words: list[str], k: int) -> bool:
+    """Whether ``words[k]`` follows a determiner and ends the request (but for "please" or
+    punctuation), where the object's name stands, and is no word the vocabulary knows there."""
+    rest = [w for w in words[k + 1:] if w not in ("please", "?", ".", "!", ",")]
+    w = words[k]
+    return k > 0 and words[k - 1] in _DETERMINERS and not rest and not _FORM_WORDS.intersection(words) \
+        and bool(difflib.get_close_matches(w, [c for c in _KEYWORDS if c in LEXICON or c in SHADES], n=1, cutoff=0.8)) \
+        and not canonical_color(w)
+
+
 def _fix_keyword_typos(words: list[str]) -> list[str]:
     """``words`` with misspelt keywords, colours, rooms and category names corrected: a word no
     list knows as English, within ``typo_distance`` of a known word that starts with the same
     letter ("ofice" office, "yelow" yellow, "cacuts" cactus, "plnat" plant); a three-letter word
     or four-letter word that drops one letter of a keyword ("nxt" next, "blu" blue, "gren" green)."""
     out = []
-    for w in words:
+    for k, w in enumerate(words):
+        if _noun_place(words, k):
+            # "where's the khazi": a word after an article that ends the request stands where the
+            # object's name does; an unknown noun there is no misspelt colour ("khaki").
+            out.append(w)
+            continue
         if w in _ENGLISH_HINTS or w in _FORM_WORDS or w in _LEX.not_typos or w in _COMMON_ADJECTIVES \
                 or w in _LEX.attributes or not w.isalpha() or len(w) < 3:
             out.append(w)
@@ -440,8 +479,8 @@ def _other_object(words: list[str], span: tuple[int, int] | None) -> str | None:
     for n in (3, 2):
         for i in range(max(0, span[1] - n), span[0] + 1):
             gram = " ".join(words[i:i + n])
-            if i + n >= span[1] and gram in _LEX.other:
-                return gram
+            if i + n >= span[1] and (gram in _LEX.other or (gram.endswith("s") and gram[:-1] in _LEX.other)):
+                return gram  # "bath towels": a plural too
     return None
 
 
