@@ -36,6 +36,7 @@ from capnav.explore.levels import Level, search_levels
 from capnav.explore.live_map import LiveMap, LiveMapConfig, Snapshot
 from capnav.explore.online_map import OnlineMap, OnlineMapConfig
 from capnav.explore.places import Place, PlaceConfig, room_places
+from capnav.language.context import canonical_label
 from capnav.language.embedder import TextEmbedder
 from capnav.mapping.cmap import CapNavMap, MapObject
 from capnav.planning import Costmap, PlannerConfig
@@ -43,6 +44,7 @@ from capnav.planning.costmap import locate_start
 from capnav.planning.search import cost_field
 from capnav.retrieval.query import ParsedQuery, parse_goals
 from capnav.retrieval.result import QueryResult
+from capnav.retrieval.verifier import a as a_
 
 
 @dataclass(frozen=True)
@@ -173,8 +175,8 @@ class ObjectSearch:
         self._answered: dict[int, MapObject] = {}  # saved objects that were the answer at some time
         self._spots: list[tuple[float, float]] = []  # where the robot looked around
         self._cells_at: tuple[int, np.ndarray] | None = None  # the online map's cells, at a number of views
-        self._held: Answer | None = None  # a confirmed answer to a superlative that a saved object gone outranks
-        self._released: set[int] = set()  # answers held back once and then taken: never held again
+        self._held: Answer | None = None  # an answer held back while the search looks for a better one (``_hold``)
+        self._released: list[Answer] = []  # answers held back once and then taken: never held again
 
     # ------------------------------------------------------------------ the request
     def run(self, instruction: str | ParsedQuery, first: QueryResult | None = None) -> SearchResult:
@@ -231,8 +233,7 @@ class ObjectSearch:
             utility[~np.isfinite(dist)] = -1.0
             if self._held is not None and (not cands or utility.max() < 0):
                 held, self._held = self._held, None
-                if held.obj is not None:
-                    self._released.add(held.obj.id)
+                self._released.append(held)
                 self._log("search", f"no place left to look for what outranks it; taking {held.reason}", ex.xy)
                 res = self._approach(held)
                 if res is not None:
@@ -274,41 +275,65 @@ class ObjectSearch:
         return self._out_of_budget()
 
     def _hold(self, ans: Answer) -> bool:
-        """Hold back a saved object confirmed at its place as the answer to a superlative ("the
-        biggest plant") while a saved object of its kind that outranks it was seen gone from its
-        place, or not at it: that one was carried somewhere, and is the answer wherever it stands
-        now. The search goes on for it (a bigger one seen is the retriever's answer), until no
-        place is left to look or half the budget is driven; then the held answer is taken.
+        """Hold back an answer the robot has seen (``new`` or ``confirmed``) while something better
+        may still stand in the part of the home not looked at, and search on for it, until no place
+        is left to look or half the budget is driven; then the held answer is taken:
 
-        Why: on seed 100 "the biggest houseplant" and "the largest plant" (twice) were answered by a
-        saved plant confirmed at its place, while the biggest, which the map had seen gone from its
-        old place, stood unseen in another room: a superlative is only as good as the part of the
-        home seen, and the map says which part of it a better candidate left."""
-        if self._held is not None and ans.kind == "confirmed" and ans.same(self._held):
+        - a superlative ("the biggest plant") whose confirmed answer a saved object of its kind,
+          seen gone from its place, outranks: that one was carried somewhere, and is the answer
+          wherever it stands now (seed 100: "the biggest houseplant" and "the largest plant"
+          answered by a saved plant at its place, while the biggest stood unseen in another room);
+        - a superlative with only its answer known of its kind (on the map, minus what was seen
+          gone, plus what was seen): "the smallest cabinet" says there are two or more, and the
+          first one seen is only the smallest of one (seed 0: the black cabinet by the toilet taken
+          for the smallest, the small one stood in the next room);
+        - a stand-in: an object of another kind that can serve as the one asked for (an armchair
+          for "the black chair"), while no object of the kind itself was found: the request named
+          that kind, and one may stand out of sight (seed 0: "the black chair" answered twice by a
+          dark grey armchair in the room where the request was heard, the black chair had been
+          set down two rooms away; seed 100: "the chair next to the armoire" by an armchair after
+          the saved chairs were seen gone from their places)."""
+        if self._held is not None and ans.same(self._held):
             if self.driven() < 0.5 * self.config.budget_m:
                 return True
             self._log("search", f"half the budget driven; taking {ans.reason}", self.explorer.xy)
             self._held = None
-            if ans.obj is not None:
-                self._released.add(ans.obj.id)
+            self._released.append(ans)
             return False
-        rival = self._outranks(ans)
-        if rival is None:
+        why = self._why_hold(ans)
+        if why is None:
             return False
-        self._held = ans
-        what = rival.caption or rival.label
-        self._held_why = (f"object {rival.id} ({what}) would be {self._parsed.superlative}, and it was seen gone "
-                          f"from its place at ({rival.position[0]:.2f}, {rival.position[1]:.2f}): looking for it")
-        self._log("search", f"{ans.reason}; held back: {self._held_why}", _xy(rival))
+        self._held, (self._held_why, xy) = ans, why
+        self._log("search", f"{ans.reason}; held back: {self._held_why}", xy)
         return True
+
+    def _why_hold(self, ans: Answer) -> tuple[str, tuple[float, float] | None] | None:
+        q, o = self._parsed, ans.obj
+        if ans.kind not in ("new", "confirmed") or o is None or self._snap is None:
+            return None
+        if (self._held is not None and ans.same(self._held)) or any(ans.same(r) for r in self._released):
+            return None
+        rival = self._outranks(ans)
+        if rival is not None:
+            what = rival.caption or rival.label
+            return (f"object {rival.id} ({what}) would be {q.superlative}, and it was seen gone from its place at "
+                    f"({rival.position[0]:.2f}, {rival.position[1]:.2f}): looking for it", _xy(rival))
+        kind = canonical_label(o.label)
+        if q.superlative in ("largest", "smallest"):
+            known = sum(1 for m in self._snap.cmap.objects if canonical_label(m.label) == kind)
+            if known < 2:
+                return (f"'{q.superlative}' says there are two or more of them, and this is the only {kind} known "
+                        f"yet: looking for the others", None)
+        if q.category is not None and kind != q.category and kind in q.category_alternatives:
+            return (f"{a_(kind)} only stands in for {a_(q.category)}, and no {q.category} that fits was found yet: "
+                    f"looking for one", None)
+        return None
 
     def _outranks(self, ans: Answer) -> MapObject | None:
         """The saved object of the answer's kind, seen gone or not at its place, that a superlative
         request would rank above a confirmed answer (by more than a tenth), if any."""
         q, snap, o = self._parsed, self._snap, ans.obj
         if q.superlative not in ("largest", "smallest") or ans.kind != "confirmed" or o is None or snap is None:
-            return None
-        if (self._held is not None and ans.same(self._held)) or o.id in self._released:
             return None
 
         def measure(m: MapObject) -> float:
@@ -581,7 +606,7 @@ class ObjectSearch:
             return True
         prev = self._answer
         ans = self._ask()
-        if self._held is not None and ans.kind == "confirmed" and ans.same(self._held):
+        if self._held is not None and ans.same(self._held):
             return False  # still the answer held back (``_hold``): drive on to look for what outranks it
         return ans is not prev and (ans.kind in ("new", "confirmed") or not ans.same(prev))
 
