@@ -16,7 +16,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "mapping"))
 from _synth_scene import Box, HashEmbedder, render
-from test_object_search import CHAIR, K, _captioned, _gap, _room_a, _search
+from test_object_search import CHAIR, LAMP, PLANT, K, _captioned, _gap, _room_a, _search
 
 from capnav.core.geometry import look_at_pose
 from capnav.mapping import CapNavMap, build_map
@@ -61,3 +61,18 @@ def test_the_smallest_of_one_seen_waits_for_the_others(room_a_map: CapNavMap) ->
     assert res.found, res.reason
     assert _gap(agent, small) <= 1.0 and _gap(agent, big) > 1.0, (agent.pose, res.reason)
     assert any("says there are two or more" in s.reason for s in res.steps), [s.reason for s in res.steps]
+
+
+def test_the_only_plant_known_far_from_any_lamp_is_not_the_one_next_to_the_lamp(room_a_map: CapNavMap) -> None:
+    """A plant and a lamp set down in room A, four metres apart, and another plant beside the lamp
+    in room B's corner: "the plant next to the lamp" is not the one in room A, the only plant
+    known when the robot has looked around (the retriever orders plants by the gap to a lamp and
+    takes the first, however far it is); the search looks on and goes to the one by the lamp."""
+    far = Box((-0.9, -2.6, 0.0), (-0.5, -2.2, 1.0), 30, PLANT, (40, 140, 50))
+    lamp = Box((-2.6, 2.2, 0.0), (-2.3, 2.5, 1.6), 31, LAMP, (240, 220, 90))
+    by_lamp = Box((2.2, -2.0, 0.0), (2.55, -1.65, 1.0), 32, PLANT, (40, 140, 50))
+    world = [*_room_a((-0.3, 2.0)), far, lamp, by_lamp]
+    agent, res = _search(room_a_map, world, "the plant next to the lamp")
+    assert res.found, res.reason
+    assert _gap(agent, by_lamp) <= 1.0 and _gap(agent, far) > 1.0, (agent.pose, res.reason)
+    assert any("not next to one" in s.reason for s in res.steps), [s.reason for s in res.steps]

@@ -114,6 +114,9 @@ class SearchResult:
                 "steps": [s.to_dict() for s in self.steps]}
 
 
+#: Relations of nearness to a landmark, whose answer must stand within the captions' "next to" of one.
+NEAR_RELATIONS = ("next to", "close to", "beside", "besides", "near", "by")
+
 #: The region of a place that is a second look at an object seen (not a room region, not a frontier).
 SECOND_LOOK = -2
 
@@ -129,6 +132,7 @@ class Answer:
     obj: MapObject | None
     reason: str
     seen: int = 0  # objects seen that the saved map does not explain, when asked
+    unmet: str | None = None  # why the answer does not stand where the request's landmark relation says
 
     def same(self, other: Answer | None) -> bool:
         if other is None or other.kind != self.kind:
@@ -292,7 +296,10 @@ class ObjectSearch:
           that kind, and one may stand out of sight (seed 0: "the black chair" answered twice by a
           dark grey armchair in the room where the request was heard, the black chair had been
           set down two rooms away; seed 100: "the chair next to the armoire" by an armchair after
-          the saved chairs were seen gone from their places)."""
+          the saved chairs were seen gone from their places);
+        - a relation of nearness the answer does not meet (``_unmet``): "the plant beside the
+          washer" answered by the only plant left, 1.6 m from any washer (seed 0, twice: the plant
+          by the washer had been carried to the bedroom)."""
         if self._held is not None and ans.same(self._held):
             if self.driven() < 0.5 * self.config.budget_m:
                 return True
@@ -318,6 +325,8 @@ class ObjectSearch:
             what = rival.caption or rival.label
             return (f"object {rival.id} ({what}) would be {q.superlative}, and it was seen gone from its place at "
                     f"({rival.position[0]:.2f}, {rival.position[1]:.2f}): looking for it", _xy(rival))
+        if ans.unmet is not None:
+            return f"{ans.unmet}: looking for one that is", None
         kind = canonical_label(o.label)
         if q.superlative in ("largest", "smallest"):
             known = sum(1 for m in self._snap.cmap.objects if canonical_label(m.label) == kind)
@@ -529,14 +538,39 @@ class ObjectSearch:
         what = f"object {o.id} ({o.caption or o.label}) at ({o.position[0]:.2f}, {o.position[1]:.2f})"
         missing = [c for c in (self._parsed.anchor_category, self._parsed.anchor2_category)
                    if c is not None and not len(r.of_category(c))]
+        unmet = self._unmet(r, o)
         if o.id in snap.seen_new:
             if missing:
                 return Answer("open", o, f"{what}, seen, but no {' or '.join(missing)} seen yet to judge it by; "
                                          "looking on", n)
-            return Answer("new", o, f"{what}, seen by the robot; {q.reason}", n)
+            return Answer("new", o, f"{what}, seen by the robot; {q.reason}", n, unmet)
         if o.id in snap.confirmed:
-            return Answer("confirmed", o, f"{what}, seen again at its place; {q.reason}", n)
+            return Answer("confirmed", o, f"{what}, seen again at its place; {q.reason}", n, unmet)
         return Answer("saved", o, f"{what}, not seen yet; {q.reason}", n)
+
+    def _unmet(self, r: Any, o: MapObject) -> str | None:
+        """Why ``o`` is not where a request's landmark relation of nearness ("the plant beside the
+        washer") puts it: the gap from its box to the nearest box of the landmark's kind known (on
+        the map, minus what was seen gone, plus what was seen) is over the captions' "next to"
+        (``SceneContext.config.next_to_distance``). The retriever orders the candidates by that gap
+        and takes the first however far it is: the only plant left is "the plant beside the washer"
+        even three metres from any washer."""
+        q = self._parsed
+        if q.relation not in NEAR_RELATIONS or q.anchor_category is None or q.proximity_to_anchor:
+            return None
+        ids = [x.id for x in r.objects]
+        if o.id not in ids:
+            return None
+        i = ids.index(o.id)
+        anchors = [int(k) for k in r.of_category(q.anchor_category) if int(k) != i]
+        if not anchors:
+            return None
+        gap = float(min(r.scene.gap[i, k] for k in anchors))
+        lim = float(r.scene.config.next_to_distance)
+        if gap <= lim:
+            return None
+        return (f"it stands {gap:.1f} m from the nearest {q.anchor_category} known, not {q.relation} one (within "
+                f"{lim:.1f} m)")
 
     def _none_text(self, ans: Answer) -> str:
         return f"the answer is still: {ans.reason}"
