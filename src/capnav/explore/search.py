@@ -36,6 +36,7 @@ from capnav.explore.levels import Level, search_levels
 from capnav.explore.live_map import LiveMap, LiveMapConfig, Snapshot
 from capnav.explore.online_map import OnlineMap, OnlineMapConfig
 from capnav.explore.places import Place, PlaceConfig, room_places
+from capnav.language.context import canonical_label
 from capnav.language.embedder import TextEmbedder
 from capnav.mapping.cmap import CapNavMap, MapObject
 from capnav.planning import Costmap, PlannerConfig
@@ -43,6 +44,7 @@ from capnav.planning.costmap import locate_start
 from capnav.planning.search import cost_field
 from capnav.retrieval.query import ParsedQuery, parse_goals
 from capnav.retrieval.result import QueryResult
+from capnav.retrieval.verifier import a as a_
 
 
 @dataclass(frozen=True)
@@ -112,6 +114,9 @@ class SearchResult:
                 "steps": [s.to_dict() for s in self.steps]}
 
 
+#: Relations of nearness to a landmark, whose answer must stand within the captions' "next to" of one.
+NEAR_RELATIONS = ("next to", "close to", "beside", "besides", "near", "by")
+
 #: The region of a place that is a second look at an object seen (not a room region, not a frontier).
 SECOND_LOOK = -2
 
@@ -127,6 +132,7 @@ class Answer:
     obj: MapObject | None
     reason: str
     seen: int = 0  # objects seen that the saved map does not explain, when asked
+    unmet: str | None = None  # why the answer does not stand where the request's landmark relation says
 
     def same(self, other: Answer | None) -> bool:
         if other is None or other.kind != self.kind:
@@ -173,8 +179,8 @@ class ObjectSearch:
         self._answered: dict[int, MapObject] = {}  # saved objects that were the answer at some time
         self._spots: list[tuple[float, float]] = []  # where the robot looked around
         self._cells_at: tuple[int, np.ndarray] | None = None  # the online map's cells, at a number of views
-        self._held: Answer | None = None  # a confirmed answer to a superlative that a saved object gone outranks
-        self._released: set[int] = set()  # answers held back once and then taken: never held again
+        self._held: Answer | None = None  # an answer held back while the search looks for a better one (``_hold``)
+        self._released: list[Answer] = []  # answers held back once and then taken: never held again
 
     # ------------------------------------------------------------------ the request
     def run(self, instruction: str | ParsedQuery, first: QueryResult | None = None) -> SearchResult:
@@ -231,8 +237,7 @@ class ObjectSearch:
             utility[~np.isfinite(dist)] = -1.0
             if self._held is not None and (not cands or utility.max() < 0):
                 held, self._held = self._held, None
-                if held.obj is not None:
-                    self._released.add(held.obj.id)
+                self._released.append(held)
                 self._log("search", f"no place left to look for what outranks it; taking {held.reason}", ex.xy)
                 res = self._approach(held)
                 if res is not None:
@@ -274,41 +279,70 @@ class ObjectSearch:
         return self._out_of_budget()
 
     def _hold(self, ans: Answer) -> bool:
-        """Hold back a saved object confirmed at its place as the answer to a superlative ("the
-        biggest plant") while a saved object of its kind that outranks it was seen gone from its
-        place, or not at it: that one was carried somewhere, and is the answer wherever it stands
-        now. The search goes on for it (a bigger one seen is the retriever's answer), until no
-        place is left to look or half the budget is driven; then the held answer is taken.
+        """Hold back an answer the robot has seen (``new`` or ``confirmed``) while something better
+        may still stand in the part of the home not looked at, and search on for it, until no place
+        is left to look or half the budget is driven; then the held answer is taken:
 
-        Why: on seed 100 "the biggest houseplant" and "the largest plant" (twice) were answered by a
-        saved plant confirmed at its place, while the biggest, which the map had seen gone from its
-        old place, stood unseen in another room: a superlative is only as good as the part of the
-        home seen, and the map says which part of it a better candidate left."""
-        if self._held is not None and ans.kind == "confirmed" and ans.same(self._held):
+        - a superlative ("the biggest plant") whose confirmed answer a saved object of its kind,
+          seen gone from its place, outranks: that one was carried somewhere, and is the answer
+          wherever it stands now (seed 100: "the biggest houseplant" and "the largest plant"
+          answered by a saved plant at its place, while the biggest stood unseen in another room);
+        - a superlative with only its answer known of its kind (on the map, minus what was seen
+          gone, plus what was seen): "the smallest cabinet" says there are two or more, and the
+          first one seen is only the smallest of one (seed 0: the black cabinet by the toilet taken
+          for the smallest, the small one stood in the next room);
+        - a stand-in: an object of another kind that can serve as the one asked for (an armchair
+          for "the black chair"), while no object of the kind itself was found: the request named
+          that kind, and one may stand out of sight (seed 0: "the black chair" answered twice by a
+          dark grey armchair in the room where the request was heard, the black chair had been
+          set down two rooms away; seed 100: "the chair next to the armoire" by an armchair after
+          the saved chairs were seen gone from their places);
+        - a relation of nearness the answer does not meet (``_unmet``): "the plant beside the
+          washer" answered by the only plant left, 1.6 m from any washer (seed 0, twice: the plant
+          by the washer had been carried to the bedroom)."""
+        if self._held is not None and ans.same(self._held):
             if self.driven() < 0.5 * self.config.budget_m:
                 return True
             self._log("search", f"half the budget driven; taking {ans.reason}", self.explorer.xy)
             self._held = None
-            if ans.obj is not None:
-                self._released.add(ans.obj.id)
+            self._released.append(ans)
             return False
-        rival = self._outranks(ans)
-        if rival is None:
+        why = self._why_hold(ans)
+        if why is None:
             return False
-        self._held = ans
-        what = rival.caption or rival.label
-        self._held_why = (f"object {rival.id} ({what}) would be {self._parsed.superlative}, and it was seen gone "
-                          f"from its place at ({rival.position[0]:.2f}, {rival.position[1]:.2f}): looking for it")
-        self._log("search", f"{ans.reason}; held back: {self._held_why}", _xy(rival))
+        self._held, (self._held_why, xy) = ans, why
+        self._log("search", f"{ans.reason}; held back: {self._held_why}", xy)
         return True
+
+    def _why_hold(self, ans: Answer) -> tuple[str, tuple[float, float] | None] | None:
+        q, o = self._parsed, ans.obj
+        if ans.kind not in ("new", "confirmed") or o is None or self._snap is None:
+            return None
+        if (self._held is not None and ans.same(self._held)) or any(ans.same(r) for r in self._released):
+            return None
+        rival = self._outranks(ans)
+        if rival is not None:
+            what = rival.caption or rival.label
+            return (f"object {rival.id} ({what}) would be {q.superlative}, and it was seen gone from its place at "
+                    f"({rival.position[0]:.2f}, {rival.position[1]:.2f}): looking for it", _xy(rival))
+        if ans.unmet is not None:
+            return f"{ans.unmet}: looking for one that is", None
+        kind = canonical_label(o.label)
+        if q.superlative in ("largest", "smallest"):
+            known = sum(1 for m in self._snap.cmap.objects if canonical_label(m.label) == kind)
+            if known < 2:
+                return (f"'{q.superlative}' says there are two or more of them, and this is the only {kind} known "
+                        f"yet: looking for the others", None)
+        if q.category is not None and kind != q.category and kind in q.category_alternatives:
+            return (f"{a_(kind)} only stands in for {a_(q.category)}, and no {q.category} that fits was found yet: "
+                    f"looking for one", None)
+        return None
 
     def _outranks(self, ans: Answer) -> MapObject | None:
         """The saved object of the answer's kind, seen gone or not at its place, that a superlative
         request would rank above a confirmed answer (by more than a tenth), if any."""
         q, snap, o = self._parsed, self._snap, ans.obj
         if q.superlative not in ("largest", "smallest") or ans.kind != "confirmed" or o is None or snap is None:
-            return None
-        if (self._held is not None and ans.same(self._held)) or o.id in self._released:
             return None
 
         def measure(m: MapObject) -> float:
@@ -504,14 +538,39 @@ class ObjectSearch:
         what = f"object {o.id} ({o.caption or o.label}) at ({o.position[0]:.2f}, {o.position[1]:.2f})"
         missing = [c for c in (self._parsed.anchor_category, self._parsed.anchor2_category)
                    if c is not None and not len(r.of_category(c))]
+        unmet = self._unmet(r, o)
         if o.id in snap.seen_new:
             if missing:
                 return Answer("open", o, f"{what}, seen, but no {' or '.join(missing)} seen yet to judge it by; "
                                          "looking on", n)
-            return Answer("new", o, f"{what}, seen by the robot; {q.reason}", n)
+            return Answer("new", o, f"{what}, seen by the robot; {q.reason}", n, unmet)
         if o.id in snap.confirmed:
-            return Answer("confirmed", o, f"{what}, seen again at its place; {q.reason}", n)
+            return Answer("confirmed", o, f"{what}, seen again at its place; {q.reason}", n, unmet)
         return Answer("saved", o, f"{what}, not seen yet; {q.reason}", n)
+
+    def _unmet(self, r: Any, o: MapObject) -> str | None:
+        """Why ``o`` is not where a request's landmark relation of nearness ("the plant beside the
+        washer") puts it: the gap from its box to the nearest box of the landmark's kind known (on
+        the map, minus what was seen gone, plus what was seen) is over the captions' "next to"
+        (``SceneContext.config.next_to_distance``). The retriever orders the candidates by that gap
+        and takes the first however far it is: the only plant left is "the plant beside the washer"
+        even three metres from any washer."""
+        q = self._parsed
+        if q.relation not in NEAR_RELATIONS or q.anchor_category is None or q.proximity_to_anchor:
+            return None
+        ids = [x.id for x in r.objects]
+        if o.id not in ids:
+            return None
+        i = ids.index(o.id)
+        anchors = [int(k) for k in r.of_category(q.anchor_category) if int(k) != i]
+        if not anchors:
+            return None
+        gap = float(min(r.scene.gap[i, k] for k in anchors))
+        lim = float(r.scene.config.next_to_distance)
+        if gap <= lim:
+            return None
+        return (f"it stands {gap:.1f} m from the nearest {q.anchor_category} known, not {q.relation} one (within "
+                f"{lim:.1f} m)")
 
     def _none_text(self, ans: Answer) -> str:
         return f"the answer is still: {ans.reason}"
@@ -581,7 +640,7 @@ class ObjectSearch:
             return True
         prev = self._answer
         ans = self._ask()
-        if self._held is not None and ans.kind == "confirmed" and ans.same(self._held):
+        if self._held is not None and ans.same(self._held):
             return False  # still the answer held back (``_hold``): drive on to look for what outranks it
         return ans is not prev and (ans.kind in ("new", "confirmed") or not ans.same(prev))
 
@@ -624,16 +683,15 @@ class ObjectSearch:
         def stop(e: FrontierExplorer) -> bool:  # what the robot sees on the way may change the answer
             return self._budget_only(e) or not self._ask().same(ans)
 
-        st = ex.approach(refreshed_target, cfg.stop_distance, stop)
-        for lvl in self._levels[1:]:
-            if st is not Status.BLOCKED:
-                break
-            d = math.dist(ex.xy, target())
-            self._log("search", f"no standing cell nearer than {d:.2f} m with {self._levels[0].describe()}; "
-                                f"approaching with {lvl.describe()}", ex.xy)
+        def drive(lvl: Level, stop_at: float) -> Status:
             ex.forgive_contacts = lvl.forgive_contacts
-            st = ex.approach(refreshed_target, cfg.stop_distance, stop, planner=lvl.planner)
-            ex.forgive_contacts = False
+            try:
+                return ex.approach(refreshed_target, stop_at, stop, planner=lvl.planner)
+            finally:
+                ex.forgive_contacts = False
+
+        st = climb_levels(self._levels, drive, lambda: math.dist(ex.xy, target()), cfg.stop_distance,
+                          cfg.planner.reach, lambda text: self._log("search", text, ex.xy))
         if st is Status.STOPPED and not self._timed_out:
             return None
         goal_xy = target()
@@ -683,6 +741,34 @@ class ObjectSearch:
         return SearchResult(found, reason, target, self.driven(), self.steps, self.explorer.looks, from_map,
                             self._found_id if found and from_map else None, self.asks)
 
+
+
+def climb_levels(levels: Sequence[Level], drive: Callable[[Level, float], Status], gap: Callable[[], float],
+                 stop_distance: float, reach: float, log: Callable[[str], None]) -> Status:
+    """Approach an object one inflation level at a time (``levels.search_levels``, strictest first):
+    ``drive(level, stop_at)`` drives until within ``stop_at`` of it, ``gap()`` is the distance left.
+
+    The strictest level aims at ``stop_distance``, inside the ``reach`` that counts as arrived. A
+    looser level is tried only when the stricter one was blocked outside ``reach``, and it drives
+    only until within ``reach``: its paths graze the furniture around the object, and a robot that
+    already stood within reach and drove on for the nearer stop ended farther off than it started
+    (a plant boxed in by two armchairs: blocked at 0.88 m, then 1.30 m after the looser levels).
+    """
+    st = drive(levels[0], stop_distance)
+    tried = levels[0]
+    for lvl in levels[1:]:
+        if st is not Status.BLOCKED:
+            break
+        d = gap()
+        if d <= reach:
+            log(f"no standing cell nearer than {d:.2f} m with {tried.describe()}, within the {reach:.1f} m "
+                f"reach: stopping here, no looser inflation tried")
+            break
+        log(f"no standing cell nearer than {d:.2f} m with {tried.describe()}; approaching with {lvl.describe()} "
+            f"until within {reach:.1f} m")
+        tried = lvl
+        st = drive(lvl, reach)
+    return st
 
 
 def path_lengths(grid: OccupancyGrid, cm: Costmap, start_xy: tuple[float, float],
