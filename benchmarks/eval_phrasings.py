@@ -95,6 +95,9 @@ def main() -> None:
             both = ok and len(goals) > 1 and right(it["then"], goals[1], manifest)
             goals_all[0] += both
             goals_all[1] += 1
+            if args.failures and ok and not both:
+                second = goals[1].get("reason", "") if len(goals) > 1 else f"{len(goals)} goal(s) read"
+                print(f"[{it['kind']}, second goal] {seed} {it['instruction']!r}: {second[:300]}")
         if args.failures and not ok:
             print(f"[{it['kind']}] {seed} {it['instruction']!r}: {seq.get('reason', '')[:300]}")
     print("| kind | n | top-1 |\n|---|---:|---:|")

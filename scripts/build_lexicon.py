@@ -218,6 +218,7 @@ def build(wordnet: Path) -> dict[str, Any]:
         out["body"] = _body(wn, noun_exc)
         out["materials"], out["material_nouns"] = _materials(wn, out["forms"], out["labels"])
         out["surface_nouns"] = _surface_nouns(wn)
+        out["part_nouns"] = _part_nouns(wn)
         out["rooms"] = _rooms(wn, out["forms"], noun_exc)
         out["attributes"] = _attributes(wn, out)
         out["room_glosses"] = _room_glosses(wn)
@@ -520,6 +521,28 @@ def _surface_nouns(wn: Any) -> list[str]:
         s = wn.synset(n)
         for x in [s, *(s.hyponyms() if n == "tactile_property.n.01" else [])]:
             out |= {lem.name() for lem in x.lemmas() if lem.name().isalpha() and lem.name() == lem.name().lower()}
+    plural = {w + ("es" if w.endswith(("s", "x", "ch", "sh")) else "s") for w in out if not w.endswith("y")}
+    return sorted(out | plural | {w[:-1] + "ies" for w in out if w.endswith("y")})
+
+
+def _part_nouns(wn: Any) -> list[str]:
+    """Nouns of a piece of an object: the lemmas WordNet lists as parts (part meronyms) of a
+    category's synsets or of their hypernyms (arm, back, leg, base, drawer, frame, lampshade, pot),
+    whose first noun sense is an artifact or a body part, with their plurals. Words for the whole's
+    outline (edge, side, corner, top: locations first) are not among them, so "the sofa with
+    curved edges" keeps its shape and "the armchair with rounded arms" gives it to the arms."""
+    out: set[str] = set()
+    for roots in ROOTS.values():
+        for n in roots:
+            s = wn.synset(n.rstrip("!"))
+            for h in [s, *s.closure(lambda x: x.hypernyms())]:
+                for m in h.part_meronyms():
+                    for lem in m.lemmas():
+                        w = lem.name()
+                        first = wn.synsets(w, "n")
+                        if w.isalpha() and w == w.lower() and first and first[0].lexname() in ("noun.artifact",
+                                                                                              "noun.body"):
+                            out.add(w)
     plural = {w + ("es" if w.endswith(("s", "x", "ch", "sh")) else "s") for w in out if not w.endswith("y")}
     return sorted(out | plural | {w[:-1] + "ies" for w in out if w.endswith("y")})
 
@@ -1029,7 +1052,7 @@ def _furniture_senses(wn: Any, forms: dict[str, str]) -> dict[str, dict[str, Any
             owner[s] = cat
     furniture = wn.synset("furniture.n.01")
     found: dict[str, set[str]] = {}
-    for name, cat in sorted(owner.items()):
+    for name, _cat in sorted(owner.items()):
         syn = wn.synset(name)
         if furniture not in syn.closure(lambda x: x.hypernyms()):
             continue

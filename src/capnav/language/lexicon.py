@@ -65,6 +65,9 @@ class Lexicon:
     material_nouns: dict[str, str] = field(default_factory=dict)
     #: nouns for how a whole looks or feels ("feel", "finish", "texture"), never a part of it
     surface_nouns: frozenset[str] = frozenset()
+    #: nouns of a piece of an object ("arm", "legs", "base": WordNet's parts of the categories),
+    #: whose shape is the piece's, not the object's (see build_lexicon)
+    part_nouns: frozenset[str] = frozenset()
     #: a height word ("tall", "stumpy", "lower") -> "large" / "small"; "tallest", "lowest" ->
     #: "largest" / "smallest" (WordNet's, see build_lexicon): compared with the mapped heights
     heights: dict[str, str] = field(default_factory=dict)
@@ -124,6 +127,7 @@ def load_lexicon() -> Lexicon:
                   placing_past=dict(raw.get("placing_past", {})), verb_phrases=dict(raw.get("verb_phrases", {})),
                   materials=dict(raw.get("materials", {})), material_nouns=dict(raw.get("material_nouns", {})),
                   surface_nouns=frozenset(raw.get("surface_nouns", [])),
+                  part_nouns=frozenset(raw.get("part_nouns", [])),
                   heights=dict(raw.get("heights", {})),
                   height_superlatives=dict(raw.get("height_superlatives", {})),
                   rooms=dict(raw.get("rooms", {})),

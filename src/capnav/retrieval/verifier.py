@@ -288,6 +288,12 @@ class OfflineVerifier(Verifier):
         cols = self.base_colors(obj) if re.search(r"\bpot\b", q.text.lower()) else []
         return cols or self.colors(obj)
 
+    def _own_name(self, word: str, c: ColorCluster) -> float:
+        """``word``'s agreement with cluster ``c``, at least ``color_reject`` when ``word`` is the
+        name the captioner gave ``c`` (so a caption's colour never refuses its own object)."""
+        agree = term_agreement(word, c.lab)
+        return max(agree, self.config.color_reject) if c.name == word else agree
+
     def color_fit(self, q: ParsedQuery, obj: MapObject, words: list[str] | None = None) -> tuple[float, float, str]:
         """(ranking agreement, plausibility, why). The plausibility counts every shade the word
         covers in full: whether a person could call the object that colour at all ("the yellow
@@ -304,8 +310,10 @@ class OfflineVerifier(Verifier):
         seen = cols[0].name
         for word in words:
             shades = family(word)
-            # (agreement, shade index, cluster) of every observed colour cluster against every shade.
-            vals = [(term_agreement(w, c.lab) * (floor + (1.0 - floor) * min(1.0, c.fraction / 0.5)), k, j)
+            # (agreement, shade index, cluster) of every observed colour cluster against every shade;
+            # a cluster is at least plausible for the name the map itself gives it (its nearest
+            # palette colour can lie farther than ``color_reject`` allows: "teal vs observed teal").
+            vals = [(self._own_name(w, c) * (floor + (1.0 - floor) * min(1.0, c.fraction / 0.5)), k, j)
                     for j, c in enumerate(cols) for k, w in enumerate(shades)]
             share = [1.0] + [self.config.shade_weight * (LIGHT_SHADE_SHARE if lighter_shade(word, w) else 1.0)
                              for w in shades[1:]]

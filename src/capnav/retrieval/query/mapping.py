@@ -477,9 +477,10 @@ _PART_DETERMINERS = {"a", "an", "the", "its", "their", "some", "two", "three", "
 
 
 def _without_parts(q: ParsedQuery, words: list[str]) -> list[str]:
-    """``words`` without the materials said of a part ("the dresser with the glass top": glass is
-    the top's), which go to ``q.part_materials`` with a note: the map observes an object's surface
-    as a whole, not its parts apart, so a part's material is neither for nor against it. A part is
+    """``words`` without the materials and shapes said of a part ("the dresser with the glass top":
+    glass is the top's; "rounded arms"), which go to ``q.part_materials`` / ``q.part_shapes`` with a
+    note: the map observes an object's surface and footprint as a whole, not its parts apart, so a
+    part's material or shape is neither for nor against it. A part is
     the first word after "with" / "has" and its modifiers that no table of the lexicon holds (not
     a category, colour, material, size or shape word) and no noun of how the whole looks or feels
     ("the sofa with the velvety feel", "a walnut finish": the lexicon's ``surface_nouns``): "the
@@ -502,13 +503,17 @@ def _without_parts(q: ParsedQuery, words: list[str]) -> list[str]:
                 or _find_category([part])[0] is not None:
             continue
         mats = materials_in(words[mods:j])
-        if not mats:
+        shapes = list(dict.fromkeys(_SHAPES[w] for w in words[mods:j] if w in _SHAPES)) \
+            if part in _LEX.part_nouns else []  # "curved edges": the whole's outline, not a piece
+        if not mats and not shapes:
             continue
-        q.part_materials.setdefault(part, []).extend(m for m in mats if m not in q.part_materials.get(part, []))
-        q.notes.append(f"{'/'.join(mats)} is said of its {part}, which the map does not observe apart "
-                       f"(neither for nor against it)")
+        for said, table in ((mats, q.part_materials), (shapes, q.part_shapes)):
+            if said:
+                table.setdefault(part, []).extend(m for m in said if m not in table.get(part, []))
+        q.notes.append(f"{'/'.join([*mats, *shapes])} is said of its {part}, which the map does not observe "
+                       f"apart (neither for nor against it)")
         for i in range(mods, j):
-            if material_of(words[i]) is not None:
+            if material_of(words[i]) is not None or (shapes and words[i] in _SHAPES):
                 out[i] = ""
     return [w for w in out if w]
 
@@ -736,10 +741,11 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     q.colors = _colors(words)
     if len(q.colors) > 1 and "terracotta" in q.colors:  # "a yellow terracotta pot": a material here
         q.colors.remove("terracotta")
-    q.shapes = _shapes(words)
-    if "l-shaped" in head or "l shaped" in head:
+    whole = _without_parts(q, words)  # the words said of the target itself, not of a part of it
+    q.shapes = _shapes(whole)
+    if ("l-shaped" in head or "l shaped" in head) and "L-shaped" not in {s for v in q.part_shapes.values() for s in v}:
         q.shapes = list(dict.fromkeys([*q.shapes, "L-shaped"]))
-    q.materials = materials_in(_without_parts(q, words))
+    q.materials = materials_in(whole)
     cat, span, fuzzy = _find_category(words)
     # A word that is a material only as a noun ("plush": lavish as an adjective; "oak": a colour
     # before a noun) is one when said in a phrase after the target's noun ("the armchair covered

@@ -63,6 +63,9 @@ class ParsedQuery:
     #: Materials said of a part of the target ("the dresser with the glass top": top -> glass):
     #: the map observes no part apart, so they neither confirm nor refuse (a note says so).
     part_materials: dict[str, list[str]] = field(default_factory=dict)
+    #: Shapes said of a part ("the armchair with rounded arms": arms -> round): the map measures the
+    #: whole footprint, so they neither confirm nor refuse either.
+    part_shapes: dict[str, list[str]] = field(default_factory=dict)
 
     @property
     def has_attributes(self) -> bool:
