@@ -12,6 +12,7 @@ from _synth_scene import HashEmbedder
 from _true_boxes import TrueBoxDetector
 
 from capnav.core.frame import Frame
+from capnav.core.geometry import look_at_pose
 from capnav.eval.surface_quality import assign, relative_size_error, surface_report
 from capnav.mapping import MapperConfig, build_map
 from capnav.mapping.lifting import LiftConfig
@@ -21,13 +22,8 @@ from capnav.sim import CameraConfig, LayoutConfig, SimConfig, Simulator
 
 
 def _look(eye: np.ndarray, target: np.ndarray) -> np.ndarray:
-    f = target - eye
-    f /= np.linalg.norm(f)
-    r = np.cross(f, [0.0, 0.0, 1.0])
-    r /= np.linalg.norm(r)
-    T = np.eye(4)
-    T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3] = r, np.cross(f, r), f, eye
-    return T
+    d = target - eye
+    return look_at_pose(eye, float(np.arctan2(d[1], d[0])), float(-np.arctan2(d[2], np.hypot(d[0], d[1]))))
 
 
 def _scene(seed: int) -> tuple[list[Frame], object, int]:

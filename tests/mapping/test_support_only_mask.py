@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from capnav.core.geometry import Intrinsics
+from capnav.core.geometry import Intrinsics, look_at_pose
 from capnav.mapping.support import SupportCutConfig, _world_points, cut_at_support
 
 K = Intrinsics(260.0, 260.0, 159.5, 119.5, 320, 240)
@@ -16,13 +16,8 @@ TOP, PANEL_Y = 0.75, 2.3
 
 
 def _look(eye: np.ndarray, target: np.ndarray) -> np.ndarray:
-    f = target - eye
-    f /= np.linalg.norm(f)
-    r = np.cross(f, [0.0, 0.0, 1.0])
-    r /= np.linalg.norm(r)
-    T = np.eye(4)
-    T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3] = r, np.cross(f, r), f, eye
-    return T
+    d = target - eye
+    return look_at_pose(eye, float(np.arctan2(d[1], d[0])), float(-np.arctan2(d[2], np.hypot(d[0], d[1]))))
 
 
 def _render(box_lo: np.ndarray, box_hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
