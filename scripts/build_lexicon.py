@@ -161,12 +161,17 @@ ROOTS: dict[str, list[str]] = {
     "ottoman": ["ottoman.n.03", "footstool.n.01"],
 }
 
+#: Synsets that only name a category (their lemmas and hyponyms' lemmas), their definitions not
+#: among its glosses (what it is for): the COCO class tv is PASCAL VOC's "tvmonitor", so monitors
+#: and screens are the class, but "watch the news" is still what a television is for.
+NAME_ROOTS: dict[str, list[str]] = {"tv": ["monitor.n.04", "screen.n.03"]}
+
 #: Branches under the roots that are not the household object (their lemmas become ``other``).
 EXCLUDE = ["pool_table.n.01", "card_table.n.01", "gaming_table.n.01", "table-tennis_table.n.01",
            "operating_table.n.01", "altar.n.01", "worktable.n.01", "platen.n.01", "booth.n.01", "lectern.n.01",
            "wheelchair.n.01", "barber_chair.n.01", "throne.n.01", "electric_chair.n.01", "highchair.n.01",
            "deathbed.n.02", "sickbed.n.01", "hospital_bed.n.01", "hammock.n.02", "chamberpot.n.01",
-           "toilet_seat.n.01", "medicine_chest.n.01"]
+           "toilet_seat.n.01", "medicine_chest.n.01", "background.n.07"]
 #: Synsets whose hyponyms (not themselves) are excluded: shop counters, bars and checkouts.
 EXCLUDE_HYPONYMS_OF = ["counter.n.01"]
 
@@ -1098,7 +1103,7 @@ def _closure(wn: Any, names: list[str], excluded: set[str]) -> set[str]:
 def _build(wn: Any) -> dict[str, Any]:
     excluded = {s.name() for n in EXCLUDE for s in wn.synset(n).closure(lambda x: x.hyponyms())} | set(EXCLUDE)
     excluded |= {s.name() for n in EXCLUDE_HYPONYMS_OF for s in wn.synset(n).closure(lambda x: x.hyponyms())}
-    members = {cat: _closure(wn, roots, excluded) for cat, roots in ROOTS.items()}
+    members = {cat: _closure(wn, roots + NAME_ROOTS.get(cat, []), excluded) for cat, roots in ROOTS.items()}
     fixture_rooms: set[str] = set()
     for cat, extra in _rooms_of_fixtures(wn).items():
         members[cat] |= _closure(wn, extra, excluded)
@@ -1189,7 +1194,7 @@ def _build(wn: Any) -> dict[str, Any]:
             "other": sorted(set(other)), "relations": relations, "glosses": glosses,
             "foreign": _foreign(wn), "english": _english(), "not_typos": _not_typos(wn, forms),
             "source": "WordNet 3.0 (Princeton University), see WORDNET_LICENSE",
-            "roots": ROOTS, "exclude": EXCLUDE}
+            "roots": ROOTS, "name_roots": NAME_ROOTS, "exclude": EXCLUDE}
 
 
 #: Words the parser corrects typos towards besides category, colour and room words.

@@ -54,3 +54,15 @@ def test_an_object_of_an_activity_is_not_the_target():
 def test_a_material_is_not_a_colour(text, material):
     q = parse_instruction(text, use_parser=False)
     assert q.colors == [] and material in q.materials
+
+
+@pytest.mark.parametrize("text", ["the monitor on the desk", "go to the screen on the wall",
+                                  "the computer monitor by the window", "the big screen in the lounge"])
+def test_a_screen_is_the_tv_class(text):
+    # The COCO class is PASCAL VOC's "tvmonitor": monitors and screens are the class, although
+    # WordNet's first senses of both words are other things (a proctor, a projection screen).
+    assert parse_instruction(text, use_parser=False).category == "tv", text
+
+
+def test_a_screen_that_is_another_thing_is_not_the_tv():
+    assert parse_instruction("the fire screen by the stove", use_parser=False).category != "tv"
