@@ -526,8 +526,7 @@ def _surface_nouns(wn: Any) -> list[str]:
         s = wn.synset(n)
         for x in [s, *(s.hyponyms() if n == "tactile_property.n.01" else [])]:
             out |= {lem.name() for lem in x.lemmas() if lem.name().isalpha() and lem.name() == lem.name().lower()}
-    plural = {w + ("es" if w.endswith(("s", "x", "ch", "sh")) else "s") for w in out if not w.endswith("y")}
-    return sorted(out | plural | {w[:-1] + "ies" for w in out if w.endswith("y")})
+    return sorted(out | _plurals(out))
 
 
 def _part_nouns(wn: Any) -> list[str]:
@@ -548,8 +547,7 @@ def _part_nouns(wn: Any) -> list[str]:
                         if w.isalpha() and w == w.lower() and first and first[0].lexname() in ("noun.artifact",
                                                                                               "noun.body"):
                             out.add(w)
-    plural = {w + ("es" if w.endswith(("s", "x", "ch", "sh")) else "s") for w in out if not w.endswith("y")}
-    return sorted(out | plural | {w[:-1] + "ies" for w in out if w.endswith("y")})
+    return sorted(out | _plurals(out))
 
 
 def _materials(wn: Any, forms: dict[str, str], labels: dict[str, str]) -> tuple[dict[str, str], dict[str, str]]:
@@ -1274,14 +1272,19 @@ def _nouns_of(wn: Any, lexname: str, exceptions: list[str]) -> list[str]:
         senses = [x for x in wn.synsets(lemma, "n") if any(lem.name() == lemma for lem in x.lemmas())]
         if senses and senses[0].lexname() == lexname and _seen(wn, lemma):
             out.add(lemma)
-    plural = {w + ("es" if w.endswith(("s", "x", "ch", "sh")) else "s") for w in out if not w.endswith("y")}
-    plural |= {w[:-1] + "ies" for w in out if w.endswith("y") and w[-2:-1] not in "aeiou"}
-    plural |= {w + "s" for w in out if w.endswith("y") and w[-2:-1] in "aeiou"}
+    plural = _plurals(out)
     for line in exceptions:
         infl, *bases = line.split()
         if infl.isalpha() and any(b in out for b in bases):
             plural.add(infl)
     return sorted(out | plural)
+
+
+def _plurals(words: set[str]) -> set[str]:
+    """The regular plurals of ``words`` (boxes, legs, potties, keys)."""
+    out = {w + ("es" if w.endswith(("s", "x", "ch", "sh")) else "s") for w in words if not w.endswith("y")}
+    out |= {w[:-1] + "ies" for w in words if w.endswith("y") and w[-2:-1] not in "aeiou"}
+    return out | {w + "s" for w in words if w.endswith("y") and w[-2:-1] in "aeiou"}
 
 
 def _seen(wn: Any, word: str) -> bool:
