@@ -96,11 +96,8 @@ def _episodes(scene: int, cfg: ChangeTrackConfig, m1: Any, m2: Any, truth: Scene
     rng = np.random.default_rng([cfg.seed, scene, 0xC4A6])
     gen1, gen2 = InstructionGenerator(m1), InstructionGenerator(m2)
     changed = {c.id: c.kind for c in m2.changes}
-    pools = {"moved": [i for i, k in changed.items() if k == "moved"],
-             "removed": [i for i, k in changed.items() if k == "removed"],
-             "added": [i for i, k in changed.items() if k == "added"],
-             "hidden": [i for i, k in changed.items() if k == "hidden"],
-             "unchanged": sorted(o.id for o in m2.objects if o.id not in changed)}
+    pools = {cls: [i for i, k in changed.items() if k == cls] for cls in CLASSES if cls != "unchanged"}
+    pools["unchanged"] = sorted(o.id for o in m2.objects if o.id not in changed)
     out: dict[str, list[Episode]] = {}
     for cls, pool in pools.items():
         eps: list[Episode] = []
