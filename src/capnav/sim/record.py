@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Iterable, Iterator
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -11,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from capnav.core.atomic import atomic_dir
+from capnav.core.frame import Frame
 from capnav.core.progress import track
 from capnav.io.dataset import DatasetWriter, check_dataset_target
 from capnav.sim.config import CameraConfig, DepthNoiseConfig, LayoutConfig, SimConfig
@@ -30,10 +32,19 @@ def planar_pose(x: float, y: float, yaw: float) -> NDArray[np.float64]:
     return T
 
 
-def _shows(sim: Simulator, T: NDArray[np.float64], ids: NDArray[np.int32]) -> bool:
-    """Whether the view from ``T`` shows any pixel of the objects ``ids``."""
-    gt = sim.render(T, index=0).gt_instance
-    return gt is not None and bool(np.isin(gt, ids).any())
+def _render_kept(sim: Simulator, poses: Iterable[NDArray[np.float64]], hide: NDArray[np.int32],
+                 kept: list[NDArray[np.float64]]) -> Iterator[Frame]:
+    """Render each pose once, numbered by the frames kept; a view showing any pixel of ``hide`` is dropped.
+
+    A visit that never entered the hidden objects' room must not see them through its door either;
+    ``kept`` collects the poses written.
+    """
+    for T in poses:
+        f = sim.render(T, index=len(kept))
+        if hide.size and f.gt_instance is not None and np.isin(f.gt_instance, hide).any():
+            continue
+        kept.append(T)
+        yield f
 
 
 def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride: int = 1, width: int = 320,
@@ -85,8 +96,6 @@ def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride
         poses = plan_exploration(sim, ExploreConfig(seed=seed, stride=stride, max_frames=frames,
                                                     skip_rooms=tuple(sorted(left_out_rooms(sim.manifest.changes)))))
         hide = np.asarray(sorted(hidden_ids(sim.manifest.changes)), dtype=np.int32)
-        if hide.size:  # a visit that never entered their room: the views into it through its door are dropped
-            poses = [T for T in poses if not _shows(sim, T, hide)]
         meta = {"source": "capnav.sim", "seed": seed, "furniture": furniture, "rooms": len(sim.manifest.rooms),
                 "objects": len(sim.manifest.objects), "depth_noise": depth_noise, "exploration": "capnav.sim.explore"}
         if sim.manifest.items:  # only then: default datasets keep their meta.json bytes
@@ -101,8 +110,8 @@ def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride
         t1 = time.perf_counter()
         # Built in a temporary sibling and swapped in whole: an interrupted --overwrite keeps the old one.
         with atomic_dir(out, overwrite=overwrite) as tmp:
-            rendered = (sim.render(T, index=i) for i, T in enumerate(track(poses, f"rendering seed {seed}",
-                                                                          enabled=progress)))
+            kept: list[NDArray[np.float64]] = []
+            rendered = _render_kept(sim, track(poses, f"rendering seed {seed}", enabled=progress), hide, kept)
             if write_layout is None:
                 with DatasetWriter(tmp, sim.intrinsics, meta) as dataset:
                     for f in rendered:
@@ -114,11 +123,11 @@ def record_dataset(seed: int, out: str | Path, frames: int | None = None, stride
                               for f in rendered), sim.intrinsics, tmp)
             t_render = time.perf_counter() - t1
             sim.manifest.save(tmp / "manifest.json")
-            traj = np.array([T[:2, 3] for T in poses]) if poses else None
+            traj = np.array([T[:2, 3] for T in kept]) if kept else None
             draw_scene(sim.manifest, tmp / "topdown.png", navigable=sim.navigable(), trajectory=traj)
         what = f"visit {visit} ({changes}) of " if visit > 1 else ""
         if export is not None:
             what = f"{export} layout{f', world tilted {tilt}' if tilt else ''}, " + what
-        return (f"wrote {len(poses)} frames ({width}x{height}) of {what}apartment seed {seed} "
+        return (f"wrote {len(kept)} frames ({width}x{height}) of {what}apartment seed {seed} "
                 f"({len(sim.manifest.rooms)} rooms, {len(sim.manifest.objects)} objects) to {out} "
                 f"[build {t_build:.2f} s, render+write {t_render:.1f} s]")
