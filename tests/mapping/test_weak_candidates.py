@@ -92,13 +92,14 @@ def test_a_table_scored_low_in_many_frames_is_an_object_and_a_one_off_is_not(emb
     assert _labels(cmap) == ["chair", "table"]
     (t,) = cmap.by_label("table")
     np.testing.assert_allclose(t.position[:2], [2.1, -0.1], atol=0.3)
-    assert t.hits >= 5
+    assert t.hits >= 5 and cmap.meta["weak_confirmed_tracks"] >= 1
 
 
 def test_clutter_seen_as_often_as_it_is_weak_stays_out(embedder) -> None:  # type: ignore[no-untyped-def]
     """A false positive repeated at 0.2 in every frame never has a confident sighting: not an object."""
     cmap = _map(Scripted({4: 0.32}, clutter_frames=tuple(range(N))), embedder)
     assert _labels(cmap) == ["chair"]  # and the table, confident once, stays below h_min too
+    assert cmap.meta["weak_confirmed_tracks"] == 0
 
 
 def test_weak_sightings_alone_need_weak_confident_zero(embedder) -> None:  # type: ignore[no-untyped-def]

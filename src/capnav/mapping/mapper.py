@@ -236,6 +236,7 @@ class Mapper:
             "carved_points": self.carved_points,
             "merged_in_frame": self.frame_merges,
             "relinked_detections": self.memory.relinks,
+            "weak_confirmed_tracks": self.memory.weak_confirmed,
             "detector": self.detector.id,
             "encoder": self.encoder.id,
             "text_space": self.encoder.text_space,

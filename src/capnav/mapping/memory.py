@@ -151,6 +151,7 @@ class ObjectMemory:
         self._inherited: dict[int, int] = {}  # track id -> detections it took over from dormant buffers
         self._next_id = 1
         self.relinks = 0  # detections moved to another object by the recheck
+        self.weak_confirmed = 0  # tracks confirmed by the weak-candidate rule (``_confirms``)
         self._rng = np.random.default_rng(self.config.seed)
 
     # ---- per frame ----------------------------------------------------------------------
@@ -174,6 +175,7 @@ class ObjectMemory:
             # neighbour (two armchairs side by side), they only help confirm it.
             inherited = self._inherited.get(track.id, 0)
             own = buf[inherited:]
+            self.weak_confirmed += confirmed == "weak"
             place = self._same_place(own or buf, busy) if confirmed == "weak" else None
             if place is not None:
                 self.objects[place].track_ids.append(track.id)
