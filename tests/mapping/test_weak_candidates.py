@@ -149,3 +149,27 @@ def test_rival_readings_of_one_box_become_the_candidates_votes() -> None:
     # at 0.12 is below the floor and taken by no candidate.
     assert [labels[k] for k in keep] == ["sofa", "tv", "table"]
     assert votes[2] == {"table": 0.17, "chair": 0.16, "bed": 0.12} and votes[0] == {} and votes[1] == {}
+
+
+def test_the_cli_takes_tracker_options(tmp_path: Path) -> None:
+    """``capnav map --tracker-option`` sets the confirmation (e.g. ``weak_confident=0`` for a
+    recording whose tables are never scored at the threshold); unknown keys are refused by name."""
+    from typer.testing import CliRunner
+
+    from capnav.cli import app
+    from capnav.io.mapfile import load_map
+
+    frames = _frames(4)
+    with DatasetWriter(tmp_path / "rec", frames[0].K) as w:
+        for f in frames:
+            w.write(f)
+    out = tmp_path / "m.capnav"
+    base = ["map", str(tmp_path / "rec"), "-o", str(out), "--noise", "oracle", "--no-progress"]
+    r = CliRunner().invoke(app, [*base, "--tracker-option", "weak_confident=0", "--tracker-option", "weak_h_min=6"])
+    assert r.exit_code == 0, r.output
+    tracker = load_map(out, voxels=False).meta["config"]["tracker"]
+    assert tracker["weak_confident"] == 0 and tracker["weak_h_min"] == 6
+    r = CliRunner().invoke(app, [*base, "--tracker-option", "weak_min=3"])
+    assert r.exit_code != 0 and "weak_min" in r.output + str(r.exception)
+    r = CliRunner().invoke(app, [*base, "--tracker-option", "weak_h_min=2"])  # below h_min
+    assert r.exit_code != 0 and "weak_h_min" in r.output + str(r.exception)
