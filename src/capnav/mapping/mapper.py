@@ -156,8 +156,9 @@ class Mapper:
             if len(confident) < len(dets):
                 try:
                     grid, table = self._encode(frame, dets)
-                except FrameError as e:
-                    return self._bad(e)
+                except FrameError as e:  # the frame is fused already: go on with its confident detections
+                    log.warning("frame %s: %s; its low-score candidates are dropped", frame.index, e.reason)
+                    dets = confident
             lifted: list[LiftedDetection] = []
             for k, d in enumerate(dets):
                 ld = lift_detection(frame, d, k, grid, table, self.config.lift)
