@@ -13,6 +13,7 @@ that a COCO class maps to (``capnav.perception.coco.TO_CAPNAV``), pooled over th
 
 - recall: instances seen in >= 5 frames (>= 100 px each) with at least one map object on them;
 - precision: map objects labelled with the category that lie on an instance (of any category);
+  pooled, "on no instance" counts every map object (of any label) on no instance at all;
 - duplicates: map objects beyond the first on the category's instances, over the objects on them;
 - category accuracy: objects on the category's instances that carry its label;
 - size error: median over the category's mapped instances of ``map_quality.size_error`` (the larger
@@ -89,6 +90,7 @@ def score(cmap: Any, manifest: Any, seen: dict[int, int], counts: dict[str, dict
         if o.label in cats:
             counts[o.label]["labelled"] += 1
             counts[o.label]["labelled_on"] += o.id in on_instance
+        counts[""]["off"] += o.id not in on_instance  # on no instance of any category: a false object
 
 
 def main() -> None:
@@ -166,11 +168,12 @@ def main() -> None:
         t = totals[d]
         allk = {key: sum(counts[d][c][key] for c in cats) for key in ("found", "seen", "labelled_on", "labelled",
                                                                        "dups", "on", "right")}
-        rows.append([d, str(int(t["objects"])), pct(allk["found"], allk["seen"]),
+        rows.append([d, str(int(t["objects"])), str(int(counts[d][""]["off"])), pct(allk["found"], allk["seen"]),
                      pct(allk["labelled_on"], allk["labelled"]), pct(allk["dups"], allk["on"]),
                      pct(allk["right"], allk["on"]), str(int(t["merged"])),
                      f"{t['frames'] / max(t['seconds'], 1e-9):.1f}"])
-    table("all COCO-covered categories pooled", ["detector", "objects", "recall", "precision", "duplicates",
+    table("all COCO-covered categories pooled", ["detector", "objects", "on no instance", "recall", "precision",
+                                                 "duplicates",
                                                  "category acc.", "merged at export", "frames/s (CPU)"], rows)
     if any(surf.values()):
         rows = []

@@ -34,6 +34,24 @@ def parse_detector_options(items: list[str]) -> dict[str, Any]:
     return out
 
 
+def _tracker(items: list[str]) -> Any:
+    """``TrackerConfig`` with the ``--tracker-option`` settings (unknown keys refused by name)."""
+    import dataclasses
+
+    from capnav.core.errors import InputError
+    from capnav.mapping.tracker import TrackerConfig
+
+    opts = parse_detector_options(items)
+    known = {f.name for f in dataclasses.fields(TrackerConfig)}
+    unknown = sorted(set(opts) - known)
+    if unknown:
+        raise InputError(f"unknown --tracker-option {', '.join(unknown)}; known: {', '.join(sorted(known))}")
+    try:
+        return TrackerConfig(**opts)
+    except TypeError as e:
+        raise InputError(f"--tracker-option: {e}") from None
+
+
 def register(app: typer.Typer) -> None:
     @app.command("map")
     def map_cmd(
@@ -49,6 +67,11 @@ def register(app: typer.Typer) -> None:
             help="detector setting passed to the backend, repeatable; VALUE is JSON when it parses, else "
                  "text (yolo-fastest/centernet: model_dir=DIR, score_threshold=0.3, classes=indoor|all; owl: "
                  "model_path=DIR, mask=depth|sam|box, ...)"),
+        tracker_option: list[str] = typer.Option(
+            [], "--tracker-option", metavar="KEY=VALUE",
+            help="tracker / confirmation setting (capnav.mapping.tracker.TrackerConfig), repeatable, VALUE as "
+                 "for --detector-option: h_min=3, weak_h_min=5 (0: no low-score candidates), weak_score=1.0, "
+                 "weak_agreement=0.667, weak_confident=1 (0: low-score sightings alone can confirm)"),
         encoder: str = typer.Option("label-embedding", help="dense feature encoder backend"),
         embedder: str = typer.Option("minilm", help="text embedder of the label-embedding encoder"),
         max_frames: MaxFrames = None,
@@ -86,7 +109,7 @@ def register(app: typer.Typer) -> None:
         except TypeError as e:  # a backend whose factory does not check its kwargs itself
             raise InputError(f"detector {detector!r} rejected its options {sorted(options)}: {e}") from None
         enc = create_encoder(encoder, embedder=create_embedder(embedder))
-        cfg = MapperConfig(on_bad_frame="raise" if strict else "skip")
+        cfg = MapperConfig(on_bad_frame="raise" if strict else "skip", tracker=_tracker(tracker_option))
         if update is not None:
             _update(update, reader, output, det, enc, cfg, transform, icp, progress)
             return
@@ -107,6 +130,10 @@ def register(app: typer.Typer) -> None:
                       f"{n_used} frame{'s' if n_used > 1 else ''} (h_min {default_h_min} asks for more sightings "
                       "than there are frames); single detections are not confirmed by a second view",
                       highlight=False)
+        if m.get("weak_confirmed_tracks"):
+            t = cfg.tracker
+            con.print(f"{m['weak_confirmed_tracks']} track(s) confirmed from low-score candidates ({t.weak_h_min} "
+                      f"sightings, {t.weak_confident} confident, agreeing on the label)", highlight=False)
         for reason, frames in _grouped(m["frames_skipped"]):
             con.print(f"[yellow]skipped {_frames(frames)}:[/] {reason}", highlight=False)
         for err in m.get("detector_errors", []):

@@ -9,6 +9,11 @@ larger one and the labels are equal or lookalikes (``capnav.core.categories.conf
 chair's box inside a table's box is a chair at the table, not a part of it). The merged
 detection keeps the larger mask united with the smaller, the union box, the best score and the
 best-scoring label, and every label's score as ``votes`` for the tracker and the object memory.
+
+Weak candidates (``Detection.weak``, below the detector's score threshold) are merged only with
+each other, and one whose mask lies mostly (``weak_covered``) on the pixels of the frame's
+confident detections is dropped: those pixels are explained, and a low-score second reading of
+them (CenterNet's "bench" at 0.2 on the box of a chair at 0.5) is not another thing.
 """
 
 from __future__ import annotations
@@ -32,10 +37,11 @@ class FrameMergeConfig:
     enabled: bool = True
     same_iou: float = 0.6
     part_inside: float = 0.85
+    weak_covered: float = 0.5
 
     def __post_init__(self) -> None:
-        if not (0.0 < self.same_iou <= 1.0 and 0.0 < self.part_inside <= 1.0):
-            raise InputError("same_iou and part_inside must be in (0, 1]")
+        if not (0.0 < self.same_iou <= 1.0 and 0.0 < self.part_inside <= 1.0 and 0.0 < self.weak_covered <= 1.0):
+            raise InputError("same_iou, part_inside and weak_covered must be in (0, 1]")
 
 
 def _related(a: str, b: str) -> bool:
@@ -44,8 +50,21 @@ def _related(a: str, b: str) -> bool:
 
 def merge_frame_detections(dets: Sequence[Detection], cfg: FrameMergeConfig | None = None
                            ) -> tuple[list[Detection], int]:
-    """Merge the detections of one frame that show one thing; returns (detections, merges)."""
+    """Merge the detections of one frame that show one thing; returns (detections, merges).
+    Confident detections come first, then the weak candidates left (see the module docstring)."""
     cfg = cfg or FrameMergeConfig()
+    strong, weak = [d for d in dets if not d.weak], [d for d in dets if d.weak]
+    if not weak:
+        return _merge(strong, cfg)
+    out, merges = _merge(strong, cfg)
+    if out:
+        seen = np.logical_or.reduce([d.mask for d in out])
+        weak = [d for d in weak if int((d.mask & seen).sum()) < cfg.weak_covered * max(d.area, 1)]
+    kept, more = _merge(weak, cfg)
+    return out + kept, merges + more
+
+
+def _merge(dets: Sequence[Detection], cfg: FrameMergeConfig) -> tuple[list[Detection], int]:
     out = list(dets)
     if not cfg.enabled or len(out) < 2:
         return out, 0
@@ -82,4 +101,4 @@ def _combine(a: Detection, b: Detection) -> Detection:
     box = box_from_mask(mask)
     ub = (min(a.box[0], b.box[0]), min(a.box[1], b.box[1]), max(a.box[2], b.box[2]), max(a.box[3], b.box[3]))
     return Detection(ub if np.all(np.isfinite(ub)) else box, lead.class_id, lead.label, max(a.score, b.score),
-                     mask, votes)
+                     mask, votes, weak=a.weak and b.weak)

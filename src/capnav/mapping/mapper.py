@@ -27,7 +27,7 @@ from capnav.mapping.objects import Observation
 from capnav.mapping.occupancy import OccupancyConfig, occupancy_from_voxels
 from capnav.mapping.tracker import SG3DTracker, TrackerConfig
 from capnav.mapping.voxel_map import VoxelConfig, VoxelMap, random_projection
-from capnav.perception.base import DenseFeatureEncoder, Detector, needs_truth_error, validate_detections
+from capnav.perception.base import DenseFeatureEncoder, Detection, Detector, needs_truth_error, validate_detections
 
 log = logging.getLogger(__name__)
 
@@ -130,7 +130,9 @@ class Mapper:
         if self.detector.needs_truth and frame.gt_instance is None and not self.frames_used:
             raise needs_truth_error(self.detector, f"frame {frame.index}")  # a stream of real frames
         try:
-            dets = validate_detections(frame, self.detector.detect(frame))
+            weak_on = self.config.tracker.weak_h_min > 0
+            found = self.detector.detect_candidates(frame) if weak_on else self.detector.detect(frame)
+            dets = validate_detections(frame, found)
             dets, n_merged = merge_frame_detections(dets, self.config.frame_merge)
             self.frame_merges += n_merged
         except Exception as e:  # any detector failure: the frame's geometry still counts
@@ -138,17 +140,11 @@ class Mapper:
                 raise
             self._detector_failed(frame.index, e)
             dets = None
+        confident = [d for d in dets or [] if not d.weak]
         try:
-            grid, table = self.encoder.encode_indexed(frame, dets or [])
-            grid = np.asarray(grid, dtype=np.int64)
-            table = np.asarray(table, dtype=np.float32)
-            if table.ndim != 2 or table.shape[1] != self.encoder.dim or grid.ndim != 2:
-                raise FrameError(frame.index, f"encoder returned grid {grid.shape} / table {table.shape}, "
-                                              f"expected (H', W') / (M, {self.encoder.dim})")
-            if grid.size == 0 or grid.min() < 0 or grid.max() >= len(table):
-                raise FrameError(frame.index, "encoder feature grid indexes outside its table")
-            if not np.all(np.isfinite(table)):
-                raise FrameError(frame.index, "encoder returned non-finite features")
+            # The voxels' features come from the confident detections only; the weak candidates'
+            # own descriptors (for association) from a second encoding with them painted in.
+            grid, table = self._encode(frame, confident)
         except FrameError as e:
             return self._bad(e)
         self.camera_path.append((int(frame.index), np.asarray(frame.T_wc, dtype=np.float64).copy()))
@@ -157,6 +153,12 @@ class Mapper:
         self.voxels.integrate_frame(frame.depth, frame.rgb, frame.K, frame.T_wc, grid, proj, vc.sigma,
                                     vc.max_depth, vc.pixel_stride)
         if dets is not None:  # a frame the detector failed on is no evidence that objects are gone
+            if len(confident) < len(dets):
+                try:
+                    grid, table = self._encode(frame, dets)
+                except FrameError as e:  # the frame is fused already: go on with its confident detections
+                    log.warning("frame %s: %s; its low-score candidates are dropped", frame.index, e.reason)
+                    dets = confident
             lifted: list[LiftedDetection] = []
             for k, d in enumerate(dets):
                 ld = lift_detection(frame, d, k, grid, table, self.config.lift)
@@ -174,6 +176,19 @@ class Mapper:
         self.seconds += time.perf_counter() - t0
         return True
 
+    def _encode(self, frame: Frame, dets: list[Detection]) -> tuple[NDArray[np.int64], NDArray[np.float32]]:
+        grid, table = self.encoder.encode_indexed(frame, dets)
+        grid = np.asarray(grid, dtype=np.int64)
+        table = np.asarray(table, dtype=np.float32)
+        if table.ndim != 2 or table.shape[1] != self.encoder.dim or grid.ndim != 2:
+            raise FrameError(frame.index, f"encoder returned grid {grid.shape} / table {table.shape}, "
+                                          f"expected (H', W') / (M, {self.encoder.dim})")
+        if grid.size == 0 or grid.min() < 0 or grid.max() >= len(table):
+            raise FrameError(frame.index, "encoder feature grid indexes outside its table")
+        if not np.all(np.isfinite(table)):
+            raise FrameError(frame.index, "encoder returned non-finite features")
+        return grid, table
+
     def _track(self, frame: Frame, lifted: list[LiftedDetection]) -> None:
         step = self.tracker.update(lifted)
         h_min = self.config.tracker.h_min
@@ -184,7 +199,8 @@ class Mapper:
                               mask_area=d.detection.area, score=float(d.detection.score), label=d.detection.label,
                               distance=d.distance, truncated=d.truncated, visibility=d.visibility)
             own = t.object_id
-            oid = self.memory.observe(t, d, obs, frame.index, h_min, busy - {own} if own is not None else busy)
+            oid = self.memory.observe(t, d, obs, frame.index, h_min, busy - {own} if own is not None else busy,
+                                      self.config.tracker)
             if oid is not None:
                 busy.add(oid)
         for t in step.deaths:
@@ -221,6 +237,7 @@ class Mapper:
             "carved_points": self.carved_points,
             "merged_in_frame": self.frame_merges,
             "relinked_detections": self.memory.relinks,
+            "weak_confirmed_tracks": self.memory.weak_confirmed,
             "detector": self.detector.id,
             "encoder": self.encoder.id,
             "text_space": self.encoder.text_space,

@@ -6,6 +6,12 @@ detection overlaps it in 3D with a compatible label takes it over, and its hits 
 track's ``h_min``. Confirmation counts the detections of one 3D thing, not of one track: a small
 object seen in a few frames scattered more than ``m_max`` apart (a plant glimpsed on passing)
 would otherwise be split over short tracks that each die below ``h_min``.
+Weak candidates (``Detection.weak``) count towards confirmation only under the stricter rule of
+``TrackerConfig.weak_h_min`` (``_confirms``): several sightings in 3D agreement whose leading
+label is both strong enough in sum and the clear majority of their label scores (a place the
+detector calls a table, a chair, a couch and a bed in turn is not confirmed as any of them). A
+place confirmed that way which lies on an object's points is that object (whatever the labels),
+and weak votes name an object only while it has no confident vote.
 On confirmation it is linked either to an existing object (a revisit: the buffered points overlap
 the object's points in 3D and the labels agree) or to a new object. Linked tracks add every later
 detection to their object. When the track dies the object stays. ``finish`` merges duplicates
@@ -27,7 +33,7 @@ from capnav.mapping.box_carving import DepthViews, carve
 from capnav.mapping.lifting import LiftedDetection
 from capnav.mapping.objects import MapObject, Observation
 from capnav.mapping.support import stands_on
-from capnav.mapping.tracker import Track, vote_weight
+from capnav.mapping.tracker import Track, TrackerConfig, vote_weight
 
 
 @dataclass(frozen=True)
@@ -110,6 +116,7 @@ class _ObjectState:
     feature: NDArray[np.float32]
     feature_weight: float = 0.0
     votes: dict[str, float] = field(default_factory=dict)
+    weak_votes: dict[str, float] = field(default_factory=dict)  # of weak candidates: name it only without votes
     observations: list[Observation] = field(default_factory=list)
     frames: set[int] = field(default_factory=set)
     hits: int = 0
@@ -120,7 +127,8 @@ class _ObjectState:
 
     @property
     def label(self) -> str:
-        return max(self.votes, key=lambda k: (self.votes[k], k)) if self.votes else "unknown"
+        votes = self.votes or self.weak_votes
+        return max(votes, key=lambda k: (votes[k], k)) if votes else "unknown"
 
 
 def _utility(o: Observation) -> float:
@@ -143,27 +151,35 @@ class ObjectMemory:
         self._inherited: dict[int, int] = {}  # track id -> detections it took over from dormant buffers
         self._next_id = 1
         self.relinks = 0  # detections moved to another object by the recheck
+        self.weak_confirmed = 0  # tracks confirmed by the weak-candidate rule (``_confirms``)
         self._rng = np.random.default_rng(self.config.seed)
 
     # ---- per frame ----------------------------------------------------------------------
     def observe(self, track: Track, det: LiftedDetection, obs: Observation, frame: int,
-                h_min: int, busy: set[int]) -> int | None:
+                h_min: int, busy: set[int], rule: TrackerConfig | None = None) -> int | None:
         """Record one matched/born detection of ``track``; returns the object id once confirmed.
 
         ``busy`` holds objects already fed by another track in this frame: they are distinct
-        from this one and cannot be re-associated with it."""
+        from this one and cannot be re-associated with it. ``rule`` gives the confirmation of weak
+        candidates (``TrackerConfig.weak_h_min``...); without it they never confirm."""
         if track.object_id is None:
             buf = self._pending.setdefault(track.id, [])
             buf.append((det, obs, frame))
             if self.config.pool_unconfirmed and self._dormant:
                 self._adopt(track, det, buf)
-            if track.hits - self._restarted.get(track.id, 0) + self._inherited.get(track.id, 0) < h_min:
+            # buf holds the track's own detections since its (re)start and the pooled ones it took over
+            confirmed = _confirms(buf, h_min, rule)
+            if confirmed is None:
                 return None
             # Linked by its own detections: pooled ones of a neighbour must not pull it onto that
             # neighbour (two armchairs side by side), they only help confirm it.
             inherited = self._inherited.get(track.id, 0)
             own = buf[inherited:]
-            oid = self._link(track, own or buf, busy)
+            self.weak_confirmed += confirmed == "weak"
+            place = self._same_place(own or buf, busy) if confirmed == "weak" else None
+            if place is not None:
+                self.objects[place].track_ids.append(track.id)
+            oid = place if place is not None else self._link(track, own or buf, busy)
             track.object_id = oid
             self._restarted.pop(track.id, None)
             self._inherited.pop(track.id, None)
@@ -186,6 +202,27 @@ class ObjectMemory:
             obj = self.objects[other]
         self._add(obj, det, obs, frame)
         return track.object_id
+
+    def _same_place(self, buf: list[tuple[LiftedDetection, Observation, int]], busy: set[int]) -> int | None:
+        """The object whose points hold most of ``buf``'s points (``min_overlap`` x 2 of them within
+        ``overlap_radius``), unless they stand on it: a place confirmed by weak candidates that
+        a confident object already occupies is that object (a weak sighting never outvotes it)."""
+        pts = np.concatenate([d.points for d, _, _ in buf]) if buf else np.zeros((0, 3), np.float32)
+        if len(pts) == 0:
+            return None
+        r = self.config.overlap_radius
+        best, best_near = None, min(1.0, 2.0 * self.config.min_overlap)
+        for obj in self.objects.values():
+            if obj.id in busy or len(obj.points) == 0:
+                continue
+            lo, hi = obj.points.min(axis=0) - r, obj.points.max(axis=0) + r
+            if np.any(pts.min(axis=0) > hi) or np.any(pts.max(axis=0) < lo):
+                continue
+            d, _ = cKDTree(obj.points).query(pts, distance_upper_bound=r)
+            near = float(np.isfinite(d).mean())
+            if near >= best_near and not stands_on(pts, obj.points):
+                best, best_near = obj.id, near
+        return best
 
     def _within(self, det: LiftedDetection, own: list[tuple[LiftedDetection, Observation, int]]) -> LiftedDetection:
         """A pooled detection's points within the track's own detections' box (``recheck_margin``
@@ -280,7 +317,7 @@ class ObjectMemory:
         return best
 
     def _compatible(self, label: str, feat: NDArray[np.floating], obj: _ObjectState) -> bool:
-        if labels_compatible(label, obj.label) or label in obj.votes:
+        if labels_compatible(label, obj.label) or label in obj.votes or label in obj.weak_votes:
             return True
         na, nb = float(np.linalg.norm(feat)), float(np.linalg.norm(obj.feature))
         return na > 0 and nb > 0 and float(np.dot(feat, obj.feature)) / (na * nb) >= self.config.min_cos
@@ -303,8 +340,9 @@ class ObjectMemory:
         cfg = self.config
         w = float(det.detection.score)
         support = vote_weight(det)  # votes weigh confidence x m² of surface, not one per box
+        votes = obj.weak_votes if det.detection.weak else obj.votes
         for label, v in det.detection.label_votes().items():
-            obj.votes[label] = obj.votes.get(label, 0.0) + v * support
+            votes[label] = votes.get(label, 0.0) + v * support
         obj.feature = ((obj.feature * obj.feature_weight + det.descriptor * w) / (obj.feature_weight + w)).astype(
             np.float32)
         obj.feature_weight += w
@@ -415,6 +453,8 @@ class ObjectMemory:
     def _absorb(self, keep: _ObjectState, gone: _ObjectState) -> None:
         for k, v in gone.votes.items():
             keep.votes[k] = keep.votes.get(k, 0.0) + v
+        for k, v in gone.weak_votes.items():
+            keep.weak_votes[k] = keep.weak_votes.get(k, 0.0) + v
         tw = keep.feature_weight + gone.feature_weight
         if tw > 0:
             keep.feature = ((keep.feature * keep.feature_weight + gone.feature * gone.feature_weight) / tw).astype(
@@ -452,7 +492,8 @@ class ObjectMemory:
         label = obj.label
         cat = BY_NAME.get(label)
         mo = MapObject(
-            id=new_id, label=label, label_votes=dict(sorted(obj.votes.items())), position=(lo + hi) / 2.0,
+            id=new_id, label=label, label_votes=dict(sorted((obj.votes or obj.weak_votes).items())),
+            position=(lo + hi) / 2.0,
             extent_min=lo, extent_max=hi, footprint=fp, points=obj.points.copy(), colors=obj.colors.copy(),
             feature=obj.feature.copy(), hits=obj.hits, first_frame=obj.first_frame, last_frame=obj.last_frame,
             observations=sorted(obj.observations, key=lambda o: o.frame_index),
@@ -460,6 +501,28 @@ class ObjectMemory:
         mo.category_id = cat.id if cat else 0
         mo.track_ids = list(obj.track_ids)
         return mo
+
+
+def _confirms(buf: list[tuple[LiftedDetection, Observation, int]], h_min: int, rule: TrackerConfig | None
+              ) -> str | None:
+    """"strong" when ``h_min`` of the sightings are confident detections; "weak" when, with weak
+    candidates among them, there are ``rule.weak_h_min`` sightings (``rule.weak_confident`` of them
+    confident) whose leading label's summed
+    score is at least ``rule.weak_score`` and ``rule.weak_agreement`` of all their label scores;
+    else None (not yet an object)."""
+    confident = sum(not d.detection.weak for d, _, _ in buf)
+    if confident >= h_min:
+        return "strong"
+    if rule is None or not rule.weak_h_min or len(buf) < max(rule.weak_h_min, h_min) or confident < rule.weak_confident:
+        return None
+    votes: dict[str, float] = {}
+    for d, _, _ in buf:
+        for label, v in d.detection.label_votes().items():
+            votes[label] = votes.get(label, 0.0) + v
+    lead = max(votes.values(), default=0.0)
+    if lead >= rule.weak_score and lead >= rule.weak_agreement * sum(votes.values()):
+        return "weak"
+    return None
 
 
 def footprint(xy: NDArray[np.float64]) -> NDArray[np.float64]:

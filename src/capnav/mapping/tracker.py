@@ -18,6 +18,14 @@ parameters; ours, for indoor mapping at 0.1-0.3 m between frames:
 * ``h_min = 3`` hits: one or two false positives never become objects. ``ObjectMemory`` counts
   them per 3D place, not per track: a track that dies unconfirmed leaves its detections to a later
   track of the same place (a small object seen in frames scattered more than ``m_max`` apart);
+* weak candidates (``Detection.weak``: a real detector's boxes below its score threshold, down to
+  its candidate floor) are tracked like any detection but can only match a track of the same or a
+  lookalike label, and confirm an object only by ``weak_h_min`` sightings, ``weak_confident`` of
+  them confident, whose leading label sums at least ``weak_score`` and holds ``weak_agreement``
+  of their summed label scores, the model's rival readings of the same boxes included
+  (``ObjectMemory.observe``); ``weak_h_min`` is never lowered for a short recording, so a
+  one-frame map keeps no weak candidate. Their label votes count only while a track or an object
+  has no confident one;
 * ``max_speed = 0.05`` m/frame clips the velocity of eq. 11 (not in the paper): objects are
   static, and the centroid jitter of a moving camera would otherwise be extrapolated during a miss.
 
@@ -34,7 +42,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
-from capnav.core.categories import BY_NAME
+from capnav.core.categories import BY_NAME, confusable
 from capnav.core.errors import InputError
 from capnav.mapping.cost import association_cost
 from capnav.mapping.lifting import LiftedDetection
@@ -58,6 +66,10 @@ class TrackerConfig:
     m_max: int = 10
     h_min: int = 3
     max_speed: float = 0.05
+    weak_h_min: int = 5  # 0: weak candidates are not asked of the detector
+    weak_score: float = 1.0
+    weak_agreement: float = 2.0 / 3.0
+    weak_confident: int = 1
 
     def __post_init__(self) -> None:
         if self.d_max <= 0 or self.tau_assoc <= 0:
@@ -67,6 +79,10 @@ class TrackerConfig:
                 raise InputError(f"{name} must be in (0, 1]")
         if self.m_max < 0 or self.h_min < 1:
             raise InputError("m_max must be >= 0 and h_min >= 1")
+        if self.weak_h_min and self.weak_h_min < self.h_min:
+            raise InputError(f"weak_h_min must be 0 (off) or at least h_min ({self.h_min}), got {self.weak_h_min}")
+        if self.weak_score < 0 or not 0.0 <= self.weak_agreement <= 1.0 or self.weak_confident < 0:
+            raise InputError("weak_score and weak_confident must be >= 0 and weak_agreement in [0, 1]")
 
     @property
     def weights(self) -> tuple[float, float, float, float]:
@@ -89,6 +105,7 @@ class Track:
     misses: int = 0
     last_update: int = 0  # tracker step of the last match
     class_votes: dict[int, float] = field(default_factory=dict)
+    weak_votes: dict[int, float] = field(default_factory=dict)  # of weak candidates: count only without class_votes
     labels: dict[int, str] = field(default_factory=dict)
     object_id: int | None = None  # persistent object this track feeds (set by ObjectMemory)
 
@@ -96,11 +113,14 @@ class Track:
     def confirmed(self) -> bool:
         return self.object_id is not None
 
-    def vote(self, class_id: int, label: str, score: float) -> None:
-        """Class ``c_j`` is the weighted majority of the track's detections (``vote_all``)."""
-        self.class_votes[class_id] = self.class_votes.get(class_id, 0.0) + float(score)
+    def vote(self, class_id: int, label: str, score: float, weak: bool = False) -> None:
+        """Class ``c_j`` is the weighted majority of the track's detections (``vote_all``); the
+        votes of weak candidates decide it only while no confident detection has voted."""
+        votes = self.weak_votes if weak else self.class_votes
+        votes[class_id] = votes.get(class_id, 0.0) + float(score)
         self.labels[class_id] = label
-        self.class_id = max(self.class_votes, key=lambda c: (self.class_votes[c], -c))
+        votes = self.class_votes or self.weak_votes
+        self.class_id = max(votes, key=lambda c: (votes[c], -c))
         self.label = self.labels[self.class_id]
 
 
@@ -117,7 +137,8 @@ def vote_all(t: Track, d: LiftedDetection) -> None:
     w = vote_weight(d)
     for label, score in d.detection.label_votes().items():
         cat = BY_NAME.get(label)
-        t.vote(d.class_id if label == d.detection.label else (cat.id if cat else 0), label, score * w)
+        t.vote(d.class_id if label == d.detection.label else (cat.id if cat else 0), label, score * w,
+               d.detection.weak)
 
 
 @dataclass
@@ -165,6 +186,11 @@ class SG3DTracker:
                 np.stack([d.position for d in dets]), np.array([d.box for d in dets], dtype=np.float64),
                 np.stack([d.descriptor for d in dets]), np.array([d.class_id for d in dets]),
                 cfg.weights, cfg.d_max, cfg.tau_assoc)
+            for j, d in enumerate(dets):  # a weak candidate is another sighting of the same kind only
+                if d.detection.weak:
+                    for r, t in enumerate(self.tracks):
+                        if t.label != d.detection.label and d.detection.label not in confusable(t.label):
+                            cost[r, j] = np.inf
             finite = np.isfinite(cost)
             if finite.any():
                 rows, cols = linear_sum_assignment(np.where(finite, cost, _BIG))

@@ -28,7 +28,11 @@ Box = tuple[float, float, float, float]
 class Detection:
     """One detection of eq. 9: ``box`` xyxy pixels, ``class_id`` (vocabulary id, 0 = unknown),
     ``label`` text, ``score`` in [0, 1] and the instance ``mask`` (H, W) bool; ``votes`` holds the
-    labels of overlapping detections of the same thing merged into it (``mapping.frame_merge``)."""
+    labels of overlapping detections of the same thing merged into it (``mapping.frame_merge``).
+    ``weak``: a low-score candidate (below the detector's score threshold, above its candidate
+    floor; ``Detector.detect_candidates``): the mapper lets it become an object only when several
+    frames' sightings agree (``TrackerConfig.weak_h_min``), and its label never outvotes a
+    confident detection's."""
 
     box: Box
     class_id: int
@@ -36,6 +40,7 @@ class Detection:
     score: float
     mask: NDArray[np.bool_]
     votes: dict[str, float] = field(default_factory=dict)  # label -> score of detections merged into this one
+    weak: bool = False
 
     def label_votes(self) -> dict[str, float]:
         """Scores per label this detection stands for: its own, plus those merged into it."""
@@ -93,6 +98,11 @@ class Detector(ABC):
     @abstractmethod
     def detect(self, frame: Frame) -> list[Detection]:
         """Detections of one frame (possibly empty)."""
+
+    def detect_candidates(self, frame: Frame) -> list[Detection]:
+        """``detect`` plus low-score candidates marked ``weak`` (for a multi-frame mapper, which
+        confirms them only by several sightings); a detector without such a floor returns ``detect``."""
+        return self.detect(frame)
 
 
 @runtime_checkable

@@ -77,12 +77,16 @@ class CocoDetector(Detector):
     def __init__(self, model: str | None = None, model_dir: str | Path | None = None, score_threshold: float = 0.3,
                  nms_iou: float = 0.45, max_detections: int = 50, classes: str | list[str] = "indoor",
                  letterbox: bool = False, threads: int = 0, mask: str = "depth", depth_band: float = 0.4,
-                 depth_extent: float = 1.5, floor_height: float | None = 0.05, min_mask_area: float = 2e-4) -> None:
+                 depth_extent: float = 1.5, floor_height: float | None = 0.05, min_mask_area: float = 2e-4,
+                 candidate_floor: float | None = 0.15, rival_floor: float = 0.1) -> None:
         model = self.models[0] if model is None else model
         if model not in self.models:
             raise InputError(f"the {self.backend} detector runs {', '.join(self.models)}; got model={model!r}")
         self.score_threshold = _number("score_threshold", score_threshold, 0.0, 1.0)
         self.nms_iou = _number("nms_iou", nms_iou, 0.0, 1.0, lo_open=True)
+        floor = None if candidate_floor is None else _number("candidate_floor", candidate_floor, 0.0, 1.0)
+        self.candidate_floor = floor if floor is not None and floor < self.score_threshold else None
+        self.rival_floor = min(_number("rival_floor", rival_floor, 0.0, 1.0), self.candidate_floor or 1.0)
         self.depth_band = _number("depth_band", depth_band, 0.0, 10.0, lo_open=True)
         self.depth_extent = _number("depth_extent", depth_extent, 0.0, 10.0)
         self.floor_height = None if floor_height is None else _number("floor_height", floor_height, -100.0, 100.0)
@@ -110,6 +114,8 @@ class CocoDetector(Detector):
         if mask == "depth":
             parts.append(f"band={self.depth_band:g}:extent={self.depth_extent:g}")
             parts.append("floor=off" if self.floor_height is None else f"floor={self.floor_height:g}")
+        if self.candidate_floor is not None:
+            parts.append(f"candidates={self.candidate_floor:g}:rivals={self.rival_floor:g}")
         self.id = ":".join(parts)
 
     def _load(self, folder: Path) -> int:
@@ -120,9 +126,11 @@ class CocoDetector(Detector):
         """Model output on a (side, side, 3) RGB uint8 image: xyxy boxes in input pixels, scores, COCO indices."""
         raise NotImplementedError
 
-    def boxes(self, frame: Frame) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    def boxes(self, frame: Frame, threshold: float | None = None
+              ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
         """Boxes (N, 4) xyxy in the frame's pixels, scores (N,), COCO indices (N,): kept classes
-        above the threshold, after per-class NMS and the cap, best first."""
+        above the threshold (``score_threshold`` unless given), after per-class NMS and the cap,
+        best first."""
         h, w = frame.shape
         rgb = np.asarray(frame.rgb)
         if rgb.shape != (h, w, 3) or rgb.dtype != np.uint8:
@@ -133,7 +141,8 @@ class CocoDetector(Detector):
         boxes = boxes.copy()
         boxes[:, [0, 2]] = np.clip((boxes[:, [0, 2]] - px) / sx, 0.0, float(w))
         boxes[:, [1, 3]] = np.clip((boxes[:, [1, 3]] - py) / sy, 0.0, float(h))
-        ok = np.isfinite(scores) & (scores >= self.score_threshold) & (cls >= 0) & (cls < len(COCO80))
+        thr = self.score_threshold if threshold is None else threshold
+        ok = np.isfinite(scores) & (scores >= thr) & (cls >= 0) & (cls < len(COCO80))
         ok &= np.all(np.isfinite(boxes), axis=1)
         ok &= ((boxes[:, 2] - boxes[:, 0]) >= 1.0) & ((boxes[:, 3] - boxes[:, 1]) >= 1.0)
         idx = np.flatnonzero(ok)
@@ -158,18 +167,68 @@ class CocoDetector(Detector):
         return [m & filled_box_mask(b, (h, w)) for m, b in zip(raw, box_list, strict=True)]
 
     def detect(self, frame: Frame) -> list[Detection]:
-        boxes, scores, cls = self.boxes(frame)
+        return self._detect(frame, None)
+
+    def detect_candidates(self, frame: Frame) -> list[Detection]:
+        """Also the boxes scored from ``candidate_floor`` up to ``score_threshold``, marked ``weak``
+        (per-class NMS over both, so a weak box never survives beside a confident one it repeats).
+        A weak candidate carries as ``votes`` the other classes the model reads on the same box
+        from ``rival_floor`` up (``rival_readings``): how sure the model is of what it is."""
+        return self._detect(frame, self.candidate_floor)
+
+    def _detect(self, frame: Frame, floor: float | None) -> list[Detection]:
+        boxes, scores, cls = self.boxes(frame, None if floor is None else self.rival_floor)
+        votes: list[dict[str, float]] = [{} for _ in scores]
+        if floor is not None:
+            names = [e[1] if (e := self.table[int(c)]) is not None else "" for c in cls]
+            keep, votes = rival_readings(boxes, scores, names, self.score_threshold, floor)
+            boxes, scores, cls = boxes[keep], scores[keep], cls[keep]
         h, w = frame.shape
         min_px = max(1, int(np.ceil(self.min_mask_area * h * w)))
         dets: list[Detection] = []
-        for b, s, c, m in zip(boxes, scores, cls, self.masks(frame, boxes), strict=True):
+        for b, s, c, m, v in zip(boxes, scores, cls, self.masks(frame, boxes), votes, strict=True):
             if int(m.sum()) < min_px:
                 continue
             entry = self.table[int(c)]
             assert entry is not None  # dropped classes are filtered in boxes()
             dets.append(Detection((float(b[0]), float(b[1]), float(b[2]), float(b[3])), entry[0], entry[1],
-                                  float(s), m))
+                                  float(s), m, v, weak=bool(s < self.score_threshold)))
         return dets
+
+
+def rival_readings(boxes: NDArray[np.float64], scores: NDArray[np.float64], labels: list[str], threshold: float,
+                   floor: float, same_iou: float = 0.6) -> tuple[NDArray[np.int64], list[dict[str, float]]]:
+    """Which boxes to keep and their label votes. Confident boxes (>= ``threshold``) are kept as they
+    are (no votes). A weak box (< ``threshold``), best first, that reaches ``floor`` and is not yet
+    taken becomes a candidate and takes every other weak box of box IoU >= ``same_iou``: a model
+    such as CenterNet reads several classes on one box (a cabinet as table 0.17, chair 0.16, couch
+    0.12, bed 0.12), and those readings are the candidate's votes; weak boxes below ``floor`` that
+    no candidate takes are dropped."""
+    order = np.argsort(-scores, kind="stable")
+    keep: list[int] = []
+    votes: list[dict[str, float]] = []
+    taken = np.zeros(len(scores), dtype=bool)
+    area = np.maximum(boxes[:, 2] - boxes[:, 0], 0) * np.maximum(boxes[:, 3] - boxes[:, 1], 0)
+    weak = scores < threshold
+    for i in order:
+        if not weak[i]:
+            keep.append(int(i))
+            votes.append({})
+            continue
+        if taken[i] or scores[i] < floor:
+            continue
+        taken[i] = True
+        iw = np.clip(np.minimum(boxes[:, 2], boxes[i, 2]) - np.maximum(boxes[:, 0], boxes[i, 0]), 0, None)
+        ih = np.clip(np.minimum(boxes[:, 3], boxes[i, 3]) - np.maximum(boxes[:, 1], boxes[i, 1]), 0, None)
+        iou = iw * ih / np.maximum(area + area[i] - iw * ih, 1e-9)
+        v = {labels[i]: float(scores[i])}
+        for j in np.flatnonzero(weak & ~taken & (iou >= same_iou)):
+            taken[j] = True
+            v[labels[j]] = v.get(labels[j], 0.0) + float(scores[j])
+        keep.append(int(i))
+        votes.append(v if len(v) > 1 else {})
+    order_kept = np.argsort(-scores[keep], kind="stable") if keep else np.zeros(0, dtype=np.int64)
+    return np.asarray(keep, dtype=np.int64)[order_kept], [votes[k] for k in order_kept]
 
 
 def _import_cv2() -> Any:
