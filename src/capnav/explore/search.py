@@ -43,6 +43,7 @@ from capnav.planning import Costmap, PlannerConfig
 from capnav.planning.costmap import locate_start
 from capnav.planning.search import cost_field
 from capnav.retrieval.query import ParsedQuery, parse_goals
+from capnav.retrieval.query.tokens import nearly_named
 from capnav.retrieval.result import QueryResult
 from capnav.retrieval.verifier import a as a_
 
@@ -287,16 +288,21 @@ class ObjectSearch:
           seen gone from its place, outranks: that one was carried somewhere, and is the answer
           wherever it stands now (seed 100: "the biggest houseplant" and "the largest plant"
           answered by a saved plant at its place, while the biggest stood unseen in another room);
-        - a superlative with only its answer known of its kind (on the map, minus what was seen
-          gone, plus what was seen): "the smallest cabinet" says there are two or more, and the
-          first one seen is only the smallest of one (seed 0: the black cabinet by the toilet taken
-          for the smallest, the small one stood in the next room);
+        - a superlative with only its answer known of its kind (what was seen, and the saved
+          map's own, even those seen gone): "the smallest cabinet" says there are two or more, and
+          the first one seen is only the smallest of one (seed 0: the black cabinet by the toilet
+          taken for the smallest, the small one stood in the next room); two saved ones, both seen
+          gone, are what the request knew of (seed 0: "the biggest nightstand" held with both saved
+          nightstands seen gone, the whole home searched, the one seen taken at 36.4 m);
         - a stand-in: an object of another kind that can serve as the one asked for (an armchair
           for "the black chair"), while no object of the kind itself was found: the request named
           that kind, and one may stand out of sight (seed 0: "the black chair" answered twice by a
           dark grey armchair in the room where the request was heard, the black chair had been
           set down two rooms away; seed 100: "the chair next to the armoire" by an armchair after
-          the saved chairs were seen gone from their places);
+          the saved chairs were seen gone from their places), unless the request's words nearly
+          name the stand-in (``tokens.nearly_named``: "the brown lunge chair" is read as a chair,
+          'lunge' being a word, and nearly says "lounge chair", an armchair: seed 7's walnut
+          armchair was held until half the budget);
         - a relation of nearness the answer does not meet (``_unmet``): "the plant beside the
           washer" answered by the only plant left, 1.6 m from any washer (seed 0, twice: the plant
           by the washer had been carried to the bedroom)."""
@@ -329,11 +335,16 @@ class ObjectSearch:
             return f"{ans.unmet}: looking for one that is", None
         kind = canonical_label(o.label)
         if q.superlative in ("largest", "smallest"):
-            known = sum(1 for m in self._snap.cmap.objects if canonical_label(m.label) == kind)
-            if known < 2:
+            # The saved map's own ones count even when seen gone: they are what the request's
+            # "two or more" knew of, and one carried off may be the one seen.
+            known = {("map", m.id) for m in self.cmap.objects if canonical_label(m.label) == kind} | \
+                {("seen", m.id) for m in self._snap.cmap.objects
+                 if canonical_label(m.label) == kind and m.id in self._snap.seen_new}
+            if len(known) < 2:
                 return (f"'{q.superlative}' says there are two or more of them, and this is the only {kind} known "
                         f"yet: looking for the others", None)
-        if q.category is not None and kind != q.category and kind in q.category_alternatives:
+        if q.category is not None and kind != q.category and kind in q.category_alternatives \
+                and nearly_named(q.text, kind) is None:
             return (f"{a_(kind)} only stands in for {a_(q.category)}, and no {q.category} that fits was found yet: "
                     f"looking for one", None)
         return None
