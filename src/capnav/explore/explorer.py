@@ -99,6 +99,7 @@ class FrontierExplorer:
         self._looked_from: tuple[float, float, float] | None = None  # pose of the last observation
         #: Plan without the contact marks on cells the depth saw free (``OnlineMap.cells``): a last resort.
         self.forgive_contacts = False
+        self.last_goal: tuple[float, float] | None = None  # the standing cell ``approach`` last aimed at
         agent_cfg = getattr(agent, "cfg", None) or getattr(agent, "config", None)
         self.turn = math.radians(float(getattr(agent_cfg, "turn_deg", 30.0)))
         self.forward = float(getattr(agent_cfg, "forward_step", 0.25))
@@ -475,10 +476,13 @@ class FrontierExplorer:
         return Status.BUDGET
 
     def approach(self, target: Callable[[], tuple[float, float] | None], stop_distance: float,
-                 stop: StopCheck | None = None, planner: PlannerConfig | None = None) -> Status:
+                 stop: StopCheck | None = None, planner: PlannerConfig | None = None,
+                 avoid: Sequence[tuple[float, float]] = (), avoid_radius: float = 0.4) -> Status:
         """Drive until within ``stop_distance`` of the (re-estimated) target, via a reachable
         standing cell chosen by the shared planner's goal selection (``planner``: another
-        inflation than the configured one, e.g. a relaxed level of ``levels.inflation_levels``)."""
+        inflation than the configured one, e.g. a relaxed level of ``levels.inflation_levels``).
+        ``avoid``: standing cells an earlier approach aimed at and could not get to; no cell within
+        ``avoid_radius`` of them is chosen. The last cell aimed at is kept in ``last_goal``."""
         plan_cfg = planner or self.config.planner
 
         def standing_cell() -> tuple[float, float] | None:
@@ -488,11 +492,21 @@ class FrontierExplorer:
             if math.dist(self.xy, t) <= stop_distance:
                 return self.xy
             grid = self.grid()
+            cm = self.costmap(grid, plan_cfg)
+            allowed = None
+            if avoid:
+                rr, cc = np.mgrid[0:grid.spec.rows, 0:grid.spec.cols]
+                centres = grid.spec.to_world(np.stack([rr.ravel(), cc.ravel()], axis=1))
+                far = np.ones(len(centres), bool)
+                for a in avoid:
+                    far &= np.hypot(centres[:, 0] - a[0], centres[:, 1] - a[1]) > avoid_radius
+                allowed = far.reshape(grid.spec.rows, grid.spec.cols)
             try:
-                g = select_goal(grid, np.array([t]), self.xy, plan_cfg, self.costmap(grid, plan_cfg))
+                g = select_goal(grid, np.array([t]), self.xy, plan_cfg, cm, allowed=allowed)
             except CapNavError:
                 return None
-            return float(g.xy[0]), float(g.xy[1])
+            self.last_goal = (float(g.xy[0]), float(g.xy[1]))
+            return self.last_goal
 
         first = standing_cell()
         if first is None:

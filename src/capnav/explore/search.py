@@ -39,10 +39,12 @@ from capnav.explore.places import Place, PlaceConfig, room_places
 from capnav.language.context import canonical_label
 from capnav.language.embedder import TextEmbedder
 from capnav.mapping.cmap import CapNavMap, MapObject
+from capnav.mapping.update import likeness
 from capnav.planning import Costmap, PlannerConfig
 from capnav.planning.costmap import locate_start
 from capnav.planning.search import cost_field
 from capnav.retrieval.query import ParsedQuery, parse_goals
+from capnav.retrieval.query.tokens import nearly_named
 from capnav.retrieval.result import QueryResult
 from capnav.retrieval.verifier import a as a_
 
@@ -67,6 +69,8 @@ class SearchConfig:
     frontier_cells: int = 20  # a smaller frontier (a pocket behind furniture) has a prior in proportion
     seen_fraction: float = 0.6  # a region looked around in and this much seen by the robot's own depth is spent
     seen_anyway: float = 0.9  # a region this much seen is spent even if the robot never stood in it
+    other_sides: int = 2  # approaches blocked outside reach: aim again this often, away from the cells tried
+    avoid_radius: float = 0.4  # m around a standing cell that could not be got to
     places: PlaceConfig = field(default_factory=PlaceConfig)
     live: LiveMapConfig = field(default_factory=LiveMapConfig)
     planner: PlannerConfig = field(default_factory=PlannerConfig)
@@ -113,9 +117,6 @@ class SearchResult:
                 "target_xy": None if self.target_xy is None else [round(v, 3) for v in self.target_xy],
                 "steps": [s.to_dict() for s in self.steps]}
 
-
-#: Relations of nearness to a landmark, whose answer must stand within the captions' "next to" of one.
-NEAR_RELATIONS = ("next to", "close to", "beside", "besides", "near", "by")
 
 #: The region of a place that is a second look at an object seen (not a room region, not a frontier).
 SECOND_LOOK = -2
@@ -181,6 +182,8 @@ class ObjectSearch:
         self._cells_at: tuple[int, np.ndarray] | None = None  # the online map's cells, at a number of views
         self._held: Answer | None = None  # an answer held back while the search looks for a better one (``_hold``)
         self._released: list[Answer] = []  # answers held back once and then taken: never held again
+        self._stand_in_for: Answer | None = None  # the saved answer a seen lookalike is approached for
+        self._alike_tried: list[Answer] = []  # lookalikes approached once (``_lookalike``)
 
     # ------------------------------------------------------------------ the request
     def run(self, instruction: str | ParsedQuery, first: QueryResult | None = None) -> SearchResult:
@@ -230,6 +233,14 @@ class ObjectSearch:
                     return res
                 continue
             if ans.kind == "saved" and ans.obj is not None:
+                alike = self._lookalike(ans)
+                if alike is not None:
+                    self._stand_in_for = ans
+                    res = self._approach(alike)
+                    self._stand_in_for = None
+                    if res is not None:
+                        return res
+                    continue
                 self._check_place(ans.obj)
                 continue
             cands, dist, levels = self._choices(places, visited, regions)
@@ -287,17 +298,23 @@ class ObjectSearch:
           seen gone from its place, outranks: that one was carried somewhere, and is the answer
           wherever it stands now (seed 100: "the biggest houseplant" and "the largest plant"
           answered by a saved plant at its place, while the biggest stood unseen in another room);
-        - a superlative with only its answer known of its kind (on the map, minus what was seen
-          gone, plus what was seen): "the smallest cabinet" says there are two or more, and the
-          first one seen is only the smallest of one (seed 0: the black cabinet by the toilet taken
-          for the smallest, the small one stood in the next room);
+        - a superlative with only its answer known of its kind (what was seen, and the saved
+          map's own, even those seen gone): "the smallest cabinet" says there are two or more, and
+          the first one seen is only the smallest of one (seed 0: the black cabinet by the toilet
+          taken for the smallest, the small one stood in the next room); two saved ones, both seen
+          gone, are what the request knew of (seed 0: "the biggest nightstand" held with both saved
+          nightstands seen gone, the whole home searched, the one seen taken at 36.4 m);
         - a stand-in: an object of another kind that can serve as the one asked for (an armchair
           for "the black chair"), while no object of the kind itself was found: the request named
           that kind, and one may stand out of sight (seed 0: "the black chair" answered twice by a
           dark grey armchair in the room where the request was heard, the black chair had been
           set down two rooms away; seed 100: "the chair next to the armoire" by an armchair after
-          the saved chairs were seen gone from their places);
-        - a relation of nearness the answer does not meet (``_unmet``): "the plant beside the
+          the saved chairs were seen gone from their places), unless the request's words nearly
+          name the stand-in (``tokens.nearly_named``: "the brown lunge chair" is read as a chair,
+          'lunge' being a word, and nearly says "lounge chair", an armchair: seed 7's walnut
+          armchair was held until half the budget);
+        - a relation of nearness the answer does not meet (``QueryResult.unmet``, the retriever's
+          relation constraint): "the plant beside the
           washer" answered by the only plant left, 1.6 m from any washer (seed 0, twice: the plant
           by the washer had been carried to the bedroom)."""
         if self._held is not None and ans.same(self._held):
@@ -329,11 +346,16 @@ class ObjectSearch:
             return f"{ans.unmet}: looking for one that is", None
         kind = canonical_label(o.label)
         if q.superlative in ("largest", "smallest"):
-            known = sum(1 for m in self._snap.cmap.objects if canonical_label(m.label) == kind)
-            if known < 2:
+            # The saved map's own ones count even when seen gone: they are what the request's
+            # "two or more" knew of, and one carried off may be the one seen.
+            known = {("map", m.id) for m in self.cmap.objects if canonical_label(m.label) == kind} | \
+                {("seen", m.id) for m in self._snap.cmap.objects
+                 if canonical_label(m.label) == kind and m.id in self._snap.seen_new}
+            if len(known) < 2:
                 return (f"'{q.superlative}' says there are two or more of them, and this is the only {kind} known "
                         f"yet: looking for the others", None)
-        if q.category is not None and kind != q.category and kind in q.category_alternatives:
+        if q.category is not None and kind != q.category and kind in q.category_alternatives \
+                and nearly_named(q.text, kind) is None:
             return (f"{a_(kind)} only stands in for {a_(q.category)}, and no {q.category} that fits was found yet: "
                     f"looking for one", None)
         return None
@@ -471,6 +493,43 @@ class ObjectSearch:
                              f"a {n.label} seen ({n.hits} views) that the request did not fit: a better look at it"))
         return out
 
+    def _lookalike(self, ans: Answer) -> Answer | None:
+        """A seen object that looks like the saved answer (``mapping.update.likeness`` at least the
+        update's ``min_likeness``, of its label) and stands nearer the robot than the answer's saved
+        place, and that the retriever would answer with were the saved one gone: the saved one
+        carried there, as the update would read it. Going to the saved place first was the longer
+        way (seed 0: "the largest nightstand" seen 1.2 m off in the bathroom, the saved place looked
+        at first through the bedroom door: 3.5 m against a 3.0 m budget)."""
+        snap, o, ex = self._snap, ans.obj, self.explorer
+        if snap is None or o is None or o.id in self.live.absent:
+            return None
+        lim = self.config.live.update.min_likeness
+        near = [n for n in snap.seen_new.values() if n.label == o.label and likeness(n, o) >= lim
+                and not any(Answer("new", n, "").same(t) for t in self._alike_tried)]
+        if not near:
+            return None
+        lvl = self._levels[0]
+        grid = ex.grid()
+        d = path_lengths(grid, ex.costmap(grid, lvl.planner), ex.xy, [_xy(o), *(_xy(n) for n in near)], lvl.planner,
+                         self.config.place_reach)
+        near = [n for n, dn in zip(near, d[1:], strict=True) if dn < d[0]]
+        if not near:
+            return None
+        self.live.absent.add(o.id)
+        try:
+            alt = self._retrieve(self.live.snapshot())
+        finally:
+            self.live.absent.discard(o.id)
+        if alt.kind != "new" or alt.obj is None or not any(Answer("new", n, "").same(alt) for n in near):
+            return None
+        self._alike_tried.append(alt)
+        n = alt.obj
+        self._log("search", f"object {n.id} ({n.caption or n.label}) seen at ({n.position[0]:.2f}, "
+                            f"{n.position[1]:.2f}) looks like the map's object {o.id} (likeness "
+                            f"{likeness(n, o):.2f}), nearer than its place, and is the answer without it: "
+                            f"the one carried there; going to it first", _xy(n))
+        return alt
+
     def _check_place(self, o: MapObject) -> None:
         """Go to a saved object's place and look around; not seen there, it is not there."""
         cfg, ex = self.config, self.explorer
@@ -538,7 +597,7 @@ class ObjectSearch:
         what = f"object {o.id} ({o.caption or o.label}) at ({o.position[0]:.2f}, {o.position[1]:.2f})"
         missing = [c for c in (self._parsed.anchor_category, self._parsed.anchor2_category)
                    if c is not None and not len(r.of_category(c))]
-        unmet = self._unmet(r, o)
+        unmet = q.unmet  # the retriever's relation: "next to" a landmark it stands farther from
         if o.id in snap.seen_new:
             if missing:
                 return Answer("open", o, f"{what}, seen, but no {' or '.join(missing)} seen yet to judge it by; "
@@ -547,30 +606,6 @@ class ObjectSearch:
         if o.id in snap.confirmed:
             return Answer("confirmed", o, f"{what}, seen again at its place; {q.reason}", n, unmet)
         return Answer("saved", o, f"{what}, not seen yet; {q.reason}", n)
-
-    def _unmet(self, r: Any, o: MapObject) -> str | None:
-        """Why ``o`` is not where a request's landmark relation of nearness ("the plant beside the
-        washer") puts it: the gap from its box to the nearest box of the landmark's kind known (on
-        the map, minus what was seen gone, plus what was seen) is over the captions' "next to"
-        (``SceneContext.config.next_to_distance``). The retriever orders the candidates by that gap
-        and takes the first however far it is: the only plant left is "the plant beside the washer"
-        even three metres from any washer."""
-        q = self._parsed
-        if q.relation not in NEAR_RELATIONS or q.anchor_category is None or q.proximity_to_anchor:
-            return None
-        ids = [x.id for x in r.objects]
-        if o.id not in ids:
-            return None
-        i = ids.index(o.id)
-        anchors = [int(k) for k in r.of_category(q.anchor_category) if int(k) != i]
-        if not anchors:
-            return None
-        gap = float(min(r.scene.gap[i, k] for k in anchors))
-        lim = float(r.scene.config.next_to_distance)
-        if gap <= lim:
-            return None
-        return (f"it stands {gap:.1f} m from the nearest {q.anchor_category} known, not {q.relation} one (within "
-                f"{lim:.1f} m)")
 
     def _none_text(self, ans: Answer) -> str:
         return f"the answer is still: {ans.reason}"
@@ -642,7 +677,13 @@ class ObjectSearch:
         ans = self._ask()
         if self._held is not None and ans.same(self._held):
             return False  # still the answer held back (``_hold``): drive on to look for what outranks it
-        return ans is not prev and (ans.kind in ("new", "confirmed") or not ans.same(prev))
+        changed = ans is not prev and (ans.kind in ("new", "confirmed") or not ans.same(prev))
+        if changed and ans.kind in ("new", "confirmed") and self._hold(ans):
+            # An answer seen that is held back at once: look on. Stopping here cut the look around
+            # at a saved answer's place short, and the chair by the fridge 1.3 m off was never in
+            # view there (seed 0: the robot drove on to look from another place).
+            return False
+        return changed
 
     def _approach(self, ans: Answer) -> SearchResult | None:
         """Go to the answer's footprint; None when a batch of views on the way changed the answer."""
@@ -681,17 +722,35 @@ class ObjectSearch:
         self._timed_out = False
 
         def stop(e: FrontierExplorer) -> bool:  # what the robot sees on the way may change the answer
-            return self._budget_only(e) or not self._ask().same(ans)
+            now = self._ask()
+            return self._budget_only(e) or not (now.same(ans) or now.same(self._stand_in_for))
+
+        avoid: list[tuple[float, float]] = []
 
         def drive(lvl: Level, stop_at: float) -> Status:
             ex.forgive_contacts = lvl.forgive_contacts
             try:
-                return ex.approach(refreshed_target, stop_at, stop, planner=lvl.planner)
+                return ex.approach(refreshed_target, stop_at, stop, planner=lvl.planner, avoid=avoid,
+                                   avoid_radius=cfg.avoid_radius)
             finally:
                 ex.forgive_contacts = False
 
+        ex.last_goal = None
         st = climb_levels(self._levels, drive, lambda: math.dist(ex.xy, target()), cfg.stop_distance,
                           cfg.planner.reach, lambda text: self._log("search", text, ex.xy))
+        # Blocked outside reach at every level: the standing cell aimed at may be one the map has
+        # free and the robot does not fit to (a slot between an armchair and a table, the far side
+        # of the object not tried). Aim once more, at the other cells by the object.
+        while st is Status.BLOCKED and len(avoid) < cfg.other_sides and ex.last_goal is not None \
+                and math.dist(ex.xy, target()) > cfg.planner.reach and not self._over(st):
+            g = ex.last_goal
+            avoid.append(g)
+            self._log("search", f"could not get nearer than {math.dist(ex.xy, target()):.2f} m by way of "
+                                f"({g[0]:.2f}, {g[1]:.2f}); aiming at the standing cells by it farther than "
+                                f"{cfg.avoid_radius:.1f} m from there", ex.xy)
+            ex.last_goal = None
+            st = climb_levels(self._levels, drive, lambda: math.dist(ex.xy, target()), cfg.stop_distance,
+                              cfg.planner.reach, lambda text: self._log("search", text, ex.xy))
         if st is Status.STOPPED and not self._timed_out:
             return None
         goal_xy = target()

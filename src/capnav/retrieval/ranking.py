@@ -3,7 +3,7 @@ order the constraints' keys give (``Ranking``)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -63,6 +63,7 @@ class Ranking:
     terms: dict[int, dict[str, float]]  # per candidate: the predicate's values (distance, volume, ...)
     refusal: str | None = None  # a reason to answer "not found" before verification
     refused_by: str | None = None  # the kind of constraint that refused
+    unmet: dict[int, str] = field(default_factory=dict)  # per candidate: the relation it does not meet
 
 
 def semantic_order(E: F32, s: NDArray[np.float32], pool: NDArray[np.intp], weights: NDArray[np.float64],

@@ -26,6 +26,9 @@ class QueryResult:
     details: list[dict[str, Any]] = field(default_factory=list)
     terms: dict[str, float] = field(default_factory=dict)  # the chosen object's terms
     verification: float | None = None  # the verifier's score of the chosen object (None: not judged)
+    #: Why the chosen object does not meet the request's relation ("next to" a landmark it stands
+    #: 1.6 m from), None when it does or the request has none: the best there is, not what was asked.
+    unmet: str | None = None
 
     def runners_up(self) -> list[dict[str, Any]]:
         out = []

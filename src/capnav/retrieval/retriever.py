@@ -237,7 +237,8 @@ class Retriever:
                            [{"terms": t, "why": w, "similarity": float(s[i]),
                              "verifier": judged[i].value if i in judged else None} for i, _, t, w in runners],
                            judged[chosen_i].terms if chosen_i in judged else {},
-                           judged[chosen_i].value if chosen_i in judged else None)
+                           judged[chosen_i].value if chosen_i in judged else None,
+                           rk.unmet.get(chosen_i) if chosen_i is not None else None)
 
     def _about_time(self, instruction: str, robot_xy: tuple[float, float] | None
                     ) -> QueryResult | ParsedQuery | None:

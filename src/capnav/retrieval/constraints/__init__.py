@@ -69,7 +69,8 @@ def rank(r: Candidates, q: ParsedQuery, s: NDArray[np.float32], robot_xy: tuple[
     for c in todo:
         if c.order >= SORT_AT:
             c.rank(st)
-    return Ranking(st.order, st.groups, st.mode, st.predicate, st.weights, terms, st.refusal, st.refused_by), st
+    return Ranking(st.order, st.groups, st.mode, st.predicate, st.weights, terms, st.refusal, st.refused_by,
+                   dict(st.unmet)), st
 
 
 __all__ = ["ATTRIBUTES", "CONTRADICTED", "RANKING", "SUPPORTED", "UNOBSERVED", "AttributeConstraint", "Evidence",

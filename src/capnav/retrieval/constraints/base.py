@@ -69,6 +69,9 @@ class RankState:
     mode: str = "semantic"
     refusal: str | None = None
     refused_by: str | None = None
+    #: Per object index: why it does not stand where the request's relation puts it ("next to" a
+    #: landmark farther than the captions' next-to distance); the order is not changed by it.
+    unmet: dict[int, str] = field(default_factory=dict)
     order: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, np.intp))  # set by the sort
     groups: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, np.int64))
     #: Per constraint kind: per object index, the evidence it reported (for the explanation).

@@ -5,6 +5,8 @@ ordered by the relation's geometry in quarter-metre bins, so attributes break on
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -15,6 +17,8 @@ from capnav.retrieval.query import ACROSS, BETWEEN, END_OF, ROOM_WITH, ParsedQue
 from capnav.retrieval.spatial import end_distance, has_long_axis, segment_distance
 
 BIN_M = 0.25  # distances closer than this are a tie on the relation
+#: Relations of nearness to a landmark, met within the captions' "next to" (``next_to_distance``).
+NEAR_RELATIONS = ("next to", "close to", "beside", "besides", "near", "by")
 LEFT_OF, RIGHT_OF = "left of", "right of"
 
 
@@ -153,4 +157,12 @@ class Relation(RankingConstraint):
             else:
                 st.group_keys.append(key)
             st.predicate = q.relation
+            if q.relation in NEAR_RELATIONS:
+                # Ordered by the gap, the first is taken however far it is: the only plant left is
+                # "the plant beside the washer" three metres from any washer. Said, not refused.
+                lim = float(r.scene.config.next_to_distance)
+                for i, g in zip(pool.tolist(), gap.tolist(), strict=True):
+                    if lim < g < math.inf:
+                        st.unmet[int(i)] = (f"it stands {g:.1f} m from the nearest {q.anchor_category}, not "
+                                            f"{q.relation} one (within {lim:.1f} m)")
         st.mode = "predicate"

@@ -114,6 +114,25 @@ def _nearest(word: str, pool: list[str]) -> str | None:
 #: wrong in "washing machine" (89.7) pass, a different word ("washing line") does not.
 _MULTI_TYPO_SCORE = 86.0
 
+
+def nearly_named(text: str, category: str) -> str | None:
+    """The multi-word name of ``category`` some words of ``text`` nearly say (rapidfuzz's ratio at
+    least ``_MULTI_TYPO_SCORE``, the parser's rule for a misspelt name) although the parser did not
+    read them as it, since a changed word is an English word of its own ("the brown lunge chair":
+    'lunge' is a word, so the parse is a chair, and the words nearly say "lounge chair", an
+    armchair), else None. A weaker reading than the parser's: for judging a stand-in only."""
+    words = re.findall(r"[a-z]+", text.lower())
+    forms = [f for f in _MULTI_FORMS if _TYPO_FORMS[f] == category]
+    for n in (3, 2):
+        pool = [f for f in forms if len(f.split()) == n]
+        for i in range(len(words) - n + 1) if pool else ():
+            hit = process.extractOne(" ".join(words[i:i + n]), pool, scorer=fuzz.ratio,
+                                     score_cutoff=_MULTI_TYPO_SCORE)
+            if hit is not None:
+                return str(hit[0])
+    return None
+
+
 _PROXIMITY = {"closest": "closest", "nearest": "closest", "near me": "closest", "closest to me": "closest",
               "farthest": "farthest", "furthest": "farthest", "most distant": "farthest"}
 _SUPERLATIVE = {"biggest": "largest", "largest": "largest", "largest one": "largest", "widest": "largest",
