@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from capnav.core.errors import InputError
@@ -52,13 +53,18 @@ def test_search_counts_only_within_three_walks() -> None:
                              start_xy=(0.0, 0.0), stop_xy=(1.0, 1.0), found=True, retrieval_correct=None,
                              query_time_s=0.0, steps=1, reason="found: ...", success_strict=True)
 
+    from capnav.core.grid import GridSpec
+    from capnav.eval.generate import SceneTruth
+
+    blind = SceneTruth(0, {1: "chair"}, {1: np.array([[5.0, 0.0], [5.5, 0.0], [5.5, 0.5], [5.0, 0.5]])},
+                       GridSpec(0.0, 0.0, 0.1, 10, 80), np.ones((10, 80), bool))  # no sight grid: the 1 m region
     short, long = rec(14.9), rec(15.1)  # the direct path: 4 m to the 1 m region, plus that metre
-    _within_budget(short, 1.0)
-    _within_budget(long, 1.0)
+    _within_budget(short, blind)
+    _within_budget(long, blind)
     assert short.success and short.success_strict
     assert not long.success and long.success_strict is False and long.reason.startswith("reached, but drove 15.1 m")
     res = {"summaries": [], "search": {"subgoals": 2, "budget": "3x", "within_budget": 1, "reached_any_length": 2}}
-    assert "within 3x 1 of 2, reached at any length 2" in table(res)
+    assert "within 3x: 1 of 2, reached at any length 2" in table(res)
 
 
 def test_track_runs_only_its_methods() -> None:
@@ -87,4 +93,4 @@ def test_hidden_objects_are_described_where_visit_two_put_them() -> None:
            "update_search": {"subgoals": 3, "budget": "3x", "within_budget": 2, "reached_any_length": 3}}
     out = table(res)
     assert "| capnav-update-search | - | - | - | - | 100.0 (3) |" in out
-    assert "capnav-update-search (hidden): reached within 3x 2 of 3" in out
+    assert "capnav-update-search (hidden): reached within 3x: 2 of 3" in out

@@ -101,3 +101,44 @@ def test_strict_in_the_objects_room_needs_the_stop_in_its_room() -> None:
     assert truth.in_goal_room((3.9, 1.2), [1]) is True
     assert truth.in_goal_room((2.8, 1.2), [1]) is False  # within 1 m and in sight (no wall drawn) but next door
     assert truth.sees_goal((2.8, 1.2), [1]) is True
+
+
+def _walled_truth() -> SceneTruth:
+    """Two rooms split by a wall at x = 3 m with a door at its top (y > 3.5 m); a sofa just past it."""
+    from capnav.sim.sightline import WALL, SightGrid
+
+    spec = GridSpec(0.0, 0.0, 0.1, 40, 80)
+    labels = np.zeros((40, 80), np.int32)
+    labels[:35, 30] = WALL
+    nav = labels == 0
+    return SceneTruth(0, {1: "sofa"}, {1: np.array([[3.3, 1.0], [3.8, 1.0], [3.8, 1.5], [3.3, 1.5]])}, spec,
+                      nav, sight=SightGrid(spec, labels))
+
+
+def test_the_walk_to_a_viewpoint_goes_round_the_wall_the_1m_region_reaches_through() -> None:
+    truth = _walled_truth()
+    start = (2.5, 1.2)  # 0.8 m from the sofa, behind the wall
+    assert truth.field([1]).at(start) == 0.0  # the plain 1 m region holds the start
+    view = truth.view_field([1])
+    assert view is not None
+    assert 3.0 < view.at(start) < 8.0  # up to the door, through it and back down to see the sofa
+    assert view.at((4.5, 1.2)) == 0.0  # in the sofa's room, within 1 m: a viewpoint
+
+
+def test_a_search_budget_is_three_walks_to_the_nearest_viewpoint() -> None:
+    from capnav.eval.change_track import _within_budget
+    from capnav.eval.metrics import SubgoalRecord
+
+    truth = _walled_truth()
+
+    def record(driven: float) -> SubgoalRecord:
+        return SubgoalRecord("capnav-search", "description/moved", 0, "e", 0, "the sofa", "sofa", [1], "name",
+                             True, 0.5, driven, truth.field([1]).at((2.5, 1.2)), (2.5, 1.2), (3.5, 0.6),
+                             True, True, 0.0, 1, reason="reached")
+
+    r = record(9.0)  # round through the door: within 3x (walk to the viewpoint + 1 m), over 3x of 1 m
+    _within_budget(r, truth)
+    assert r.success and r.view_path is not None and r.view_path > 3.0
+    r = record(40.0)
+    _within_budget(r, truth)
+    assert not r.success and r.reason.startswith("reached, but drove 40.0 m")

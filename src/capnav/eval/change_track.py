@@ -8,8 +8,9 @@ then three maps answer the same one-subgoal episodes in the visit-2 world:
 * ``capnav-remap``: visit 2 mapped from scratch;
 * ``capnav-search``: visit 1's map with ``navigate --search``, on the objects the first map does not
   hold where they are (``moved`` and ``added``): success = reached within 1 m with a driven length
-  of at most ``SEARCH_BUDGET`` times the direct path to the object (the walk from the start to the
-  1 m success region plus that metre; the harness judges the length, the search is not told it);
+  of at most ``SEARCH_BUDGET`` times the direct path to the object (the walk from the start to its
+  nearest viewpoint, a cell within 1 m with the object in sight, plus that metre; the harness judges
+  the length, the search is not told it);
 * ``capnav-update-search``: the updated map with ``navigate --search``, on the objects carried into
   a room visit 2 never entered (``hidden``, with ``--changes ...,hidden=N``): the update saw their
   old place empty and nothing of their new one, so only a search finds them (same success rule).
@@ -224,7 +225,7 @@ def run_change_scene(scene: int, cfg: ChangeTrackConfig, out: Path, progress: bo
                     for r in run_episode(method, ctx, ep, truth, f"description/{cls}"):
                         r.method = name
                         if name in SEARCH_CLASSES:
-                            _within_budget(r, truth.radius)
+                            _within_budget(r, truth)
                         records.append(r)
                         write_json(out / "logs" / name / cls / f"{ep.id}.json",
                                    {"episode": ep.model_dump(), "subgoal": r.to_dict()})
@@ -233,11 +234,15 @@ def run_change_scene(scene: int, cfg: ChangeTrackConfig, out: Path, progress: bo
                                                  "retired": len(mu.retired), "remapped": len(mr.objects)}}
 
 
-def _within_budget(r: SubgoalRecord, radius: float) -> None:
+def _within_budget(r: SubgoalRecord, truth: SceneTruth) -> None:
     """A search succeeds only when it reached the object within ``SEARCH_BUDGET`` direct paths: the
-    walk to the ``radius`` success region plus ``radius`` (a start already within reach of the
-    object still has a metre to go to it, not zero)."""
-    direct = r.shortest_path + radius
+    walk to the object's nearest viewpoint (a cell within the success radius from which it is in
+    sight: Habitat ObjectNav's shortest path, Batra et al. 2020; a cell within 1 m behind a wall is
+    no way to see it) plus ``radius`` (a start already within reach still has a metre to go)."""
+    view = truth.view_field(r.target_ids)
+    to_view = view.at(r.start_xy) if view is not None else math.inf
+    r.view_path = to_view if math.isfinite(to_view) else r.shortest_path
+    direct = r.view_path + truth.radius
     limit = SEARCH_BUDGET * direct
     if r.success and not r.path_length <= limit:
         r.success = False
@@ -269,11 +274,16 @@ def run_change_track(cfg: ChangeTrackConfig, out: Path, progress: bool = True) -
 
 def _search_figures(searched: list[SubgoalRecord]) -> dict[str, Any]:
     """How many searches reached their object within the budget, and at any length."""
-    return {"subgoals": len(searched), "budget": f"{SEARCH_BUDGET:g}x the direct path",
+    reached = [r for r in searched if r.success or r.reason.startswith("reached, but drove")]
+    return {"subgoals": len(searched), "budget": f"{SEARCH_BUDGET:g}x the walk to the nearest viewpoint",
             "within_budget": sum(r.success for r in searched),
-            "reached_any_length": sum(r.success or r.reason.startswith("reached, but drove") for r in searched),
-            "driven_over_direct": [round(r.path_length / (r.shortest_path + SUCCESS_RADIUS_M), 3) for r in searched
-                                   if r.success]}
+            # the older, stricter budget: 3x the walk to the 1 m region, which may reach through a wall
+            "within_budget_of_region": sum(r.path_length <= SEARCH_BUDGET * (r.shortest_path + SUCCESS_RADIUS_M)
+                                           for r in reached),
+            "reached_any_length": len(reached),
+            "driven_over_direct": [round(r.path_length / ((r.view_path if r.view_path is not None
+                                                           else r.shortest_path) + SUCCESS_RADIUS_M), 3)
+                                   for r in searched if r.success]}
 
 
 def table(results: dict[str, Any]) -> str:
@@ -290,9 +300,10 @@ def table(results: dict[str, Any]) -> str:
         srch = results.get(key) or {}
         if srch.get("subgoals"):
             lines.append("")
-            lines.append(f"{name} ({', '.join(SEARCH_CLASSES[name])}): reached within {srch['budget']} "
+            lines.append(f"{name} ({', '.join(SEARCH_CLASSES[name])}): reached within {srch['budget']}: "
                          f"{srch['within_budget']} of {srch['subgoals']}, reached at any length "
-                         f"{srch['reached_any_length']}")
+                         f"{srch['reached_any_length']} (within 3x the walk to the 1 m region, through walls: "
+                         f"{srch.get('within_budget_of_region', '-')})")
     cpu = results.get("cpu_seconds", {})
     if cpu:
         lines.append("")

@@ -19,7 +19,7 @@ from capnav.core.errors import DatasetError, InputError
 from capnav.core.footprint import footprint_distance
 from capnav.core.grid import GridSpec
 from capnav.eval.episodes import Episode, StartPose, Subgoal
-from capnav.sim.geodesic import DistanceField, distance_field
+from capnav.sim.geodesic import DistanceField, distance_field, field_to, region_mask
 from capnav.sim.sightline import SightGrid
 from capnav.sim.success import SUCCESS_RADIUS_M, room_index
 
@@ -53,7 +53,7 @@ class SceneTruth:
     sight: SightGrid | None = None  # walls and tall objects, for the strict (line-of-sight) success rule
     starts: NDArray[np.bool_] | None = None  # where a start may be drawn (default: every navigable cell)
     rooms: list[NDArray[np.float64]] | None = None  # room polygons, for the "in the object's room" rule
-    _fields: dict[tuple[int, ...], DistanceField] = field(default_factory=dict, repr=False)
+    _fields: dict[tuple[int | str, ...], DistanceField] = field(default_factory=dict, repr=False)
 
     @classmethod
     def from_manifest(cls, manifest: object, spec: GridSpec, navigable: NDArray[np.bool_],
@@ -107,6 +107,24 @@ class SceneTruth:
                 raise DatasetError(f"instances {missing} are not in scene {self.scene_seed}")
             self._fields[key] = distance_field(self.spec, self.navigable, [self.footprints[t] for t in key],
                                                self.radius)
+        return self._fields[key]
+
+    def view_field(self, target_ids: Sequence[int]) -> DistanceField | None:
+        """Geodesic distance to the goal's viewpoints: navigable cells within ``radius`` of a goal
+        instance from which it is in sight (Habitat ObjectNav's success region, whose nearest
+        viewpoint also gives that benchmark's shortest path; Batra et al. 2020). None without a
+        sight grid. A cell within the radius but behind a wall is no viewpoint."""
+        if self.sight is None:
+            return None
+        key: tuple[int | str, ...] = ("view", *sorted(target_ids))
+        if key not in self._fields:
+            region = np.zeros_like(self.navigable)
+            for t in sorted(set(target_ids)):
+                near = region_mask(self.spec, self.navigable, [self.footprints[t]], self.radius)
+                for r, c in np.argwhere(near):
+                    if self.sight.sees(tuple(self.spec.to_world(np.array([r, c]))), self.footprints[t], own_ids=(t,)):
+                        region[r, c] = True
+            self._fields[key] = field_to(self.spec, self.navigable, region)
         return self._fields[key]
 
     def sample_start(self, rng: np.random.Generator) -> StartPose:

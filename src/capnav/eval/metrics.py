@@ -58,6 +58,9 @@ class SubgoalRecord:
     success_strict: bool | None = None
     #: The strict rule and the stop point in the goal instance's room; None without room truth.
     success_room: bool | None = None
+    #: Geodesic start -> the nearest viewpoint (a cell within the radius with the goal in sight);
+    #: set where a budget is judged against it (the change track's searches), else None.
+    view_path: float | None = None
 
     @property
     def spl(self) -> float:

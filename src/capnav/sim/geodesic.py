@@ -95,7 +95,13 @@ def distance_field(spec: GridSpec, navigable: NDArray[np.bool_], footprints: Seq
     nav = np.asarray(navigable, dtype=bool)
     if nav.shape != (spec.rows, spec.cols):
         raise InputError(f"navigable mask {nav.shape} does not match grid ({spec.rows}, {spec.cols})")
-    region = region_mask(spec, nav, footprints, radius)
+    return field_to(spec, nav, region_mask(spec, nav, footprints, radius))
+
+
+def field_to(spec: GridSpec, navigable: NDArray[np.bool_], region: NDArray[np.bool_]) -> DistanceField:
+    """Geodesic distance from every navigable cell to the cells of ``region`` (a mask of the grid)."""
+    nav = np.asarray(navigable, dtype=bool)
+    region = np.asarray(region, dtype=bool) & nav
     dist = np.full(nav.shape, np.inf)
     if region.any():
         graph, index = grid_graph(nav, spec.resolution)
