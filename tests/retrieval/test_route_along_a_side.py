@@ -46,6 +46,10 @@ def retriever() -> Retriever:
     ("walking into the kitchen from the sitting room, the second thing on your right", 9),
     ("come through from the living room into the kitchen: which machine is there on your right?", 9),
     ("as you step into the kitchen from the lounge, the machine on your left", 4),
+    # The end of the order: "last" / "final".
+    ("the last thing on your left as you walk into the kitchen from the living room", 6),
+    ("walking into the kitchen from the lounge, the thing on your right that you pass last", 9),
+    ("entering the kitchen from the sitting room, the final thing along your left", 6),
 ])
 def test_things_along_a_side_in_the_order_passed(retriever: Retriever, text: str, oid: int) -> None:
     res = retriever.query(text)

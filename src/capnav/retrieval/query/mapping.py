@@ -840,6 +840,11 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
 
 
 
+#: The end of an order met along a route ("the last lamp", "the final plant", "you reach last").
+_LAST = {"last", "final"}
+_REACHED_LAST = re.compile(r"\b(?:reach|pass|get\s+to|come\s+to|meet|see|walk\s+past)(?:es|ed|s)?\s+(?:last|final)\b")
+
+
 def goal_query(g: GoalParse, embedder: TextEmbedder | None = None) -> ParsedQuery:
     """``ParsedQuery`` of one parsed goal: the mapping reads the words the parse attached to the
     target (``g.core``); the text embedded for similarity is the same words when the parse
@@ -855,6 +860,11 @@ def goal_query(g: GoalParse, embedder: TextEmbedder | None = None) -> ParsedQuer
         # "the third lamp from the door", "the first armchair you reach": an ordinal on the head,
         # counted in the order a route or a predicate gives.
         q.ordinal = next((_ORDINALS[m.lower()] for m in g.modifiers if m.lower() in _ORDINALS), None)
+    if q.ordinal is None and q.proximity is None and q.origin_room is not None and (
+            any(m.lower() in _LAST for m in g.modifiers) or _REACHED_LAST.search(g.core)):
+        # "the last thing on your left coming in", "the lamp you reach last": the end of the
+        # order met from the way in, which the route reverses for "farthest".
+        q.proximity = "farthest"
     if q.generic and not (q.has_attributes or q.ordinal or q.origin_room or q.side):
         q.generic = False  # "the thing" alone says nothing that could pick one object
     if q.room is None:
