@@ -52,6 +52,14 @@ def landmark_instances(st: RankState, category: str, phrase: str | None) -> NDAr
         if agree.max() > 0:
             anchors = anchors[agree >= agree.max()]
             notes.append(f"landmark '{phrase}': object {', '.join(str(r.objects[k].id) for k in anchors)}")
+    if (aq.size_word or aq.superlative) and len(anchors) > 1:
+        # "beside the bigger bed", "the lamp by the smallest table": the extreme instance of the
+        # measure the word says (height for "tall", else volume), as the captions call them.
+        measure = (r.scene.height if aq.size_axis == "height" else r.scene.volume)[anchors]
+        if measure.max() > measure.min():
+            large = (aq.superlative or aq.size_word) in ("large", "largest")
+            anchors = anchors[[int(np.argmax(measure) if large else np.argmin(measure))]]
+            notes.append(f"landmark '{phrase}': object {r.objects[int(anchors[0])].id}")
     return anchors
 
 

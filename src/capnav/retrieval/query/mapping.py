@@ -90,6 +90,12 @@ def _landmark_proximity(q: ParsedQuery, head: str) -> str:
         return head
     anchor_words = m.group("anchor").split()
     cat, span, _ = _find_category(anchor_words)
+    stand_in = _stand_in_landmark(anchor_words, head[: m.start()]) if cat is None else None
+    if stand_in is not None and not stand_in[2]:
+        # "the bed nearest the one with the blue cover": another of the target's category.
+        q.proximity, q.proximity_to_anchor = _PROX_WORDS[m.group("p")], True
+        q.anchor_category, q.anchor_phrase = stand_in[0], stand_in[1]
+        return (head[: m.start()] + " " + m.group("mid")).strip()
     if cat is None or span is None:
         return head
     q.proximity = _PROX_WORDS[m.group("p")]
@@ -236,7 +242,18 @@ def _stand_in_landmark(words: list[str], before: str) -> tuple[str, str, list[st
     target = _landmark(before.split())
     if k is None or target is None:
         return None
-    return target[0], " ".join(words[: k + 1]), words[k + 1:]
+    after = words[k + 1:]
+    if after and after[0] in _STAND_IN_POSTMODIFIERS and not any(
+            re.search(rf"\b{re.escape(r)}\b", " ".join(after)) for r in ROOM_SYNONYMS):
+        # "next to the one in the navy pot", "nearest the one with the blue cover": a phrase
+        # after the stand-in that names no room describes the landmark (the nearer noun), so its
+        # colour picks the landmark and is never the target's.
+        return target[0], " ".join(words), []
+    return target[0], " ".join(words[: k + 1]), after
+
+
+#: Words that start a phrase describing the noun before them ("the one with ...", "in ...").
+_STAND_IN_POSTMODIFIERS = {"in", "with", "that", "which", "having", "wearing", "covered", "made"}
 
 
 #: "across the coffee table from the grey one", "facing the red one across the coffee table":
