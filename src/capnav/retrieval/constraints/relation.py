@@ -15,6 +15,9 @@ from capnav.retrieval.query import ACROSS, BETWEEN, END_OF, ROOM_WITH, ParsedQue
 from capnav.retrieval.spatial import end_distance, has_long_axis, segment_distance
 
 BIN_M = 0.25  # distances closer than this are a tie on the relation
+#: Relations of nearness: the target and the landmark stand in one room.
+_NEAR_RELATIONS = {"next to", "close to", "beside", "besides", "near", "by", "alongside", "against", "on top of",
+                   "above", "below", "underneath", "beneath", "under", "atop", "on"}
 LEFT_OF, RIGHT_OF = "left of", "right of"
 
 
@@ -161,4 +164,24 @@ class Relation(RankingConstraint):
             else:
                 st.group_keys.append(key)
             st.predicate = q.relation
+            if q.relation in _NEAR_RELATIONS:
+                self._walls_between(st, anchors, gap)
         st.mode = "predicate"
+
+    def _walls_between(self, st: RankState, anchors: NDArray[np.intp], gap: NDArray[np.float64]) -> None:
+        """"the sofa next to the bed" when every sofa stands in another room than every bed and
+        farther from it than the captions' "next to": the walls the map observed say no candidate
+        is near the landmark, so it is refused (a room region of -1, walls unknown there, is no
+        evidence either way; one room cut in two regions keeps its close pairs)."""
+        r, q, pool = st.r, st.q, st.pool
+        reg = r.scene.region
+        known_anchor = [int(reg[k]) for k in anchors if int(reg[k]) >= 0]
+        if not len(pool) or len(known_anchor) < len(anchors):
+            return
+        far = r.scene.config.next_to_distance
+        apart = [int(reg[i]) >= 0 and int(reg[i]) not in known_anchor and g > far
+                 for i, g in zip(pool, gap, strict=True)]
+        if all(apart):
+            what = q.category or q.target_phrase
+            st.refuse(self.kind, f"no {what} stands {q.relation} the {q.anchor_phrase or q.anchor_category}: "
+                                 "walls stand between every one and it", override=False)
