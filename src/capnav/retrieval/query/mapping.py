@@ -363,7 +363,7 @@ def relation_name(rel: str) -> str:
     """The relation a phrase says: "beside", "by", "close to" are "next to"; "on the left-hand side
     of", "to the left of" are "left of" (and right); "on" and "atop" are "on top of"; the others as
     said."""
-    if rel in ("besides", "beside", "by", "close to", "alongside"):
+    if rel in ("besides", "beside", "by", "close to", "alongside", "at"):
         return "next to"
     if rel in ("on", "atop"):
         return "on top of"
@@ -716,15 +716,16 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                     and _find_category(m.group(1).split())[0] is not None:
                 head = m.group(1)  # "I put my mug down on the counter": where it was put is the goal
                 break
-            if m and rel == "on" and _find_category(head[:m.start()].split())[0] is None:
-                continue  # "sit on the armchair", "read on the bed": the place of a verb, the goal
+            if m and rel in ("on", "at") and _find_category(head[:m.start()].split())[0] is None:
+                continue  # "sit on the armchair", "work at the desk": the place of a verb, the goal
             if m and m.start() > 0:
                 anchor_words = m.group(1).split()
                 cat, _, _ = _find_category(anchor_words)
                 stand_in = _stand_in_landmark(anchor_words, head[: m.start()]) if cat is None else None
                 if stand_in is not None and not stand_in[2]:
                     # "the sink opposite the black one": another of the target's category.
-                    q.relation = "next to" if rel in ("besides", "beside", "by", "close to", "alongside") else rel
+                    q.relation = relation_name(rel) if rel in ("besides", "beside", "by", "close to", "alongside",
+                                                               "at") else rel
                     q.anchor_category, q.anchor_phrase = stand_in[0], stand_in[1]
                     head = head[: m.start()]
                     break
