@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from capnav.core.categories import CATEGORIES
 from capnav.language.lexicon import KIND_OF_WEIGHT, load_lexicon
 
 REPO = Path(__file__).resolve().parents[2]
@@ -129,8 +130,14 @@ def test_a_kind_word_lies_above_the_category_s_own_sense():
     wn, mod = _wordnet_and_script()
     lex = load_lexicon()
     assert lex.kinds, "the lexicon has kind words"
+    # The exception, written down: the head of a category's own two-word name is a kind of the
+    # categories with a form ending in it ("machine": WordNet files the washer under white goods).
+    heads = {n.split()[1] for c in CATEGORIES for n in (c.name, *c.synonyms) if len(n.split()) == 2}
     for word, cats in lex.kinds.items():
         senses = {s.name() for s in wn.synsets(word.replace(" ", "_"), "n")}
+        if word in heads:
+            assert all(any(f.endswith(" " + word) and c == cat for f, c in lex.forms.items()) for cat in cats)
+            continue
         for cat in cats:
             own = wn.synset(mod.ROOTS[cat][0].rstrip("!"))
             above = {a.name() for path in own.hypernym_paths() for a in path}

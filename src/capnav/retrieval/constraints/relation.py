@@ -19,6 +19,9 @@ from capnav.retrieval.spatial import end_distance, has_long_axis, segment_distan
 BIN_M = 0.25  # distances closer than this are a tie on the relation
 #: Relations of nearness to a landmark, met within the captions' "next to" (``next_to_distance``).
 NEAR_RELATIONS = ("next to", "close to", "beside", "besides", "near", "by")
+#: Relations that put the target and the landmark in one room (walls between refuse them).
+_SAME_ROOM_RELATIONS = {"next to", "close to", "beside", "besides", "near", "by", "alongside", "against",
+                        "on top of", "above", "below", "underneath", "beneath", "under", "atop", "on"}
 LEFT_OF, RIGHT_OF = "left of", "right of"
 
 
@@ -56,6 +59,14 @@ def landmark_instances(st: RankState, category: str, phrase: str | None) -> NDAr
         if agree.max() > 0:
             anchors = anchors[agree >= agree.max()]
             notes.append(f"landmark '{phrase}': object {', '.join(str(r.objects[k].id) for k in anchors)}")
+    if (aq.size_word or aq.superlative) and len(anchors) > 1:
+        # "beside the bigger bed", "the lamp by the smallest table": the extreme instance of the
+        # measure the word says (height for "tall", else volume), as the captions call them.
+        measure = (r.scene.height if aq.size_axis == "height" else r.scene.volume)[anchors]
+        if measure.max() > measure.min():
+            large = (aq.superlative or aq.size_word) in ("large", "largest")
+            anchors = anchors[[int(np.argmax(measure) if large else np.argmin(measure))]]
+            notes.append(f"landmark '{phrase}': object {r.objects[int(anchors[0])].id}")
     return anchors
 
 
@@ -157,6 +168,8 @@ class Relation(RankingConstraint):
             else:
                 st.group_keys.append(key)
             st.predicate = q.relation
+            if q.relation in _SAME_ROOM_RELATIONS:
+                self._walls_between(st, anchors, gap)
             if q.relation in NEAR_RELATIONS:
                 # Ordered by the gap, the first is taken however far it is: the only plant left is
                 # "the plant beside the washer" three metres from any washer. Said, not refused.
@@ -166,3 +179,21 @@ class Relation(RankingConstraint):
                         st.unmet[int(i)] = (f"it stands {g:.1f} m from the nearest {q.anchor_category}, not "
                                             f"{q.relation} one (within {lim:.1f} m)")
         st.mode = "predicate"
+
+    def _walls_between(self, st: RankState, anchors: NDArray[np.intp], gap: NDArray[np.float64]) -> None:
+        """"the sofa next to the bed" when every sofa stands in another room than every bed and
+        farther from it than the captions' "next to": the walls the map observed say no candidate
+        is near the landmark, so it is refused (a room region of -1, walls unknown there, is no
+        evidence either way; one room cut in two regions keeps its close pairs)."""
+        r, q, pool = st.r, st.q, st.pool
+        reg = r.scene.region
+        known_anchor = [int(reg[k]) for k in anchors if int(reg[k]) >= 0]
+        if not len(pool) or len(known_anchor) < len(anchors):
+            return
+        far = r.scene.config.next_to_distance
+        apart = [int(reg[i]) >= 0 and int(reg[i]) not in known_anchor and g > far
+                 for i, g in zip(pool, gap, strict=True)]
+        if all(apart):
+            what = q.category or q.target_phrase
+            st.refuse(self.kind, f"no {what} stands {q.relation} the {q.anchor_phrase or q.anchor_category}: "
+                                 "walls stand between every one and it", override=False)

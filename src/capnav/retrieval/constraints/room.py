@@ -81,6 +81,17 @@ class Room(RankingConstraint):
             k = int(np.argmax(strength))
             st.notes.append(f"none is inferred to be in the {room}, but object {r.objects[pool[k]].id} "
                             f"({r.scene.rooms[pool[k]]}) has {room} cues where it stands ({strength[k]:.2f})")
+        elif in_room.any():
+            # The map shows where the named room is and candidates stand in it: one that stands
+            # elsewhere, with no cue of the room where it stands, is evidence against, not a
+            # fallback for when those in the room are refused ("the cactus in the office" is not
+            # the hallway's cactus once the office's plant is no cactus).
+            away = (in_room == 0) & (unknown == 0) & (strength < r.scene.config.room_min_score)
+            if away.any():
+                st.notes.append(f"left out, standing outside the {room}: "
+                                + ", ".join(f"object {r.objects[i].id} ({r.scene.rooms[i] or 'a room of no type'})"
+                                            for i in pool[away]))
+                st.keep(~away)
 
     def _hallway(self, st: RankState) -> None:
         # A hallway has no characteristic objects: objects of a region without any room's cues

@@ -74,6 +74,16 @@ def neighbours(labels: NDArray[np.int32], region: int) -> set[int]:
     return out - {region, -1}
 
 
+def side_of(heading: NDArray[np.float64], door: NDArray[np.float64], lo: NDArray[np.float64],
+            hi: NDArray[np.float64]) -> float:
+    """+1 when the box ``lo``..``hi`` lies wholly left of the line walked from ``door`` along
+    ``heading``, -1 wholly right, 0 when the line crosses it (the thing is straight ahead: a
+    cabinet on the far wall is on neither side of someone walking towards it)."""
+    corners = np.array([[lo[0], lo[1]], [hi[0], lo[1]], [lo[0], hi[1]], [hi[0], hi[1]]]) - door
+    cross = heading[0] * corners[:, 1] - heading[1] * corners[:, 0]
+    return 1.0 if (cross > 0).all() else -1.0 if (cross < 0).all() else 0.0
+
+
 @ranking
 class Route(RankingConstraint):
     kind = "route"
@@ -106,7 +116,8 @@ class Route(RankingConstraint):
         # regions next to it (the nearest of them when it has several).
         own = all(int(scene.region[i]) in origin for i in pool if int(scene.region[i]) >= 0)
         dist = np.full(len(pool), np.inf)
-        side = np.zeros(len(pool))  # +1 left, -1 right, 0 unknown
+        ahead = np.zeros(len(pool))  # how far along the walking direction (m)
+        side = np.zeros(len(pool))  # +1 left, -1 right, 0 across the line walked (straight ahead)
         doors: dict[int, list[tuple[NDArray[np.float64], NDArray[np.float64]]]] = {}
         for k, i in enumerate(pool):
             reg = int(scene.region[i])
@@ -123,8 +134,8 @@ class Route(RankingConstraint):
                 v = np.asarray(r.objects[i].position[:2], dtype=np.float64) - door
                 if float(np.linalg.norm(v)) < dist[k]:
                     dist[k] = float(np.linalg.norm(v))
-                    cross = heading[0] * v[1] - heading[1] * v[0]
-                    side[k] = 1.0 if cross > 0 else -1.0
+                    ahead[k] = float(heading @ v)
+                    side[k] = side_of(heading, door, scene.lo[i], scene.hi[i])
         known = np.isfinite(dist)
         if not known.any():
             st.notes.append(f"no candidate stands in a region that opens onto the {q.origin_room}; "
@@ -139,10 +150,12 @@ class Route(RankingConstraint):
             where = f"{dist[k]:.1f} m from the {q.origin_room}'s door" if own else \
                 f"{dist[k]:.1f} m from the way in from the {q.origin_room}"
             if want:
-                where += f", on the {'left' if side[k] > 0 else 'right'}"
+                where += f", on the {'left' if side[k] > 0 else 'right'}" if side[k] else ", straight ahead"
             st.report(self.kind, int(i), Evidence(self.kind, SUPPORTED, 1.0, where))
-        # "the bookshelf furthest from the office door": the order from the way in, reversed.
-        rank_key = np.where(known, -dist if q.proximity == "farthest" else dist, 1e9)
+        # "the bookshelf furthest from the office door": the order from the way in, reversed. Along
+        # one side ("the third thing on your left"), the order they are passed: how far ahead.
+        met = ahead if want else dist
+        rank_key = np.where(known, -met if q.proximity == "farthest" else met, 1e9)
         if want:
             # The side first, then the order met from the way in.
             st.group_keys.append(-(side == want).astype(np.float64))

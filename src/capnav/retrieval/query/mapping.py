@@ -90,6 +90,12 @@ def _landmark_proximity(q: ParsedQuery, head: str) -> str:
         return head
     anchor_words = m.group("anchor").split()
     cat, span, _ = _find_category(anchor_words)
+    stand_in = _stand_in_landmark(anchor_words, head[: m.start()]) if cat is None else None
+    if stand_in is not None and not stand_in[2]:
+        # "the bed nearest the one with the blue cover": another of the target's category.
+        q.proximity, q.proximity_to_anchor = _PROX_WORDS[m.group("p")], True
+        q.anchor_category, q.anchor_phrase = stand_in[0], stand_in[1]
+        return (head[: m.start()] + " " + m.group("mid")).strip()
     if cat is None or span is None:
         return head
     q.proximity = _PROX_WORDS[m.group("p")]
@@ -236,7 +242,18 @@ def _stand_in_landmark(words: list[str], before: str) -> tuple[str, str, list[st
     target = _landmark(before.split())
     if k is None or target is None:
         return None
-    return target[0], " ".join(words[: k + 1]), words[k + 1:]
+    after = words[k + 1:]
+    if after and after[0] in _STAND_IN_POSTMODIFIERS and not any(
+            re.search(rf"\b{re.escape(r)}\b", " ".join(after)) for r in ROOM_SYNONYMS):
+        # "next to the one in the navy pot", "nearest the one with the blue cover": a phrase
+        # after the stand-in that names no room describes the landmark (the nearer noun), so its
+        # colour picks the landmark and is never the target's.
+        return target[0], " ".join(words), []
+    return target[0], " ".join(words[: k + 1]), after
+
+
+#: Words that start a phrase describing the noun before them ("the one with ...", "in ...").
+_STAND_IN_POSTMODIFIERS = {"in", "with", "that", "which", "having", "wearing", "covered", "made"}
 
 
 #: "across the coffee table from the grey one", "facing the red one across the coffee table":
@@ -346,7 +363,7 @@ def relation_name(rel: str) -> str:
     """The relation a phrase says: "beside", "by", "close to" are "next to"; "on the left-hand side
     of", "to the left of" are "left of" (and right); "on" and "atop" are "on top of"; the others as
     said."""
-    if rel in ("besides", "beside", "by", "close to", "alongside"):
+    if rel in ("besides", "beside", "by", "close to", "alongside", "at"):
         return "next to"
     if rel in ("on", "atop"):
         return "on top of"
@@ -699,15 +716,16 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                     and _find_category(m.group(1).split())[0] is not None:
                 head = m.group(1)  # "I put my mug down on the counter": where it was put is the goal
                 break
-            if m and rel == "on" and _find_category(head[:m.start()].split())[0] is None:
-                continue  # "sit on the armchair", "read on the bed": the place of a verb, the goal
+            if m and rel in ("on", "at") and _find_category(head[:m.start()].split())[0] is None:
+                continue  # "sit on the armchair", "work at the desk": the place of a verb, the goal
             if m and m.start() > 0:
                 anchor_words = m.group(1).split()
                 cat, _, _ = _find_category(anchor_words)
                 stand_in = _stand_in_landmark(anchor_words, head[: m.start()]) if cat is None else None
                 if stand_in is not None and not stand_in[2]:
                     # "the sink opposite the black one": another of the target's category.
-                    q.relation = "next to" if rel in ("besides", "beside", "by", "close to", "alongside") else rel
+                    q.relation = relation_name(rel) if rel in ("besides", "beside", "by", "close to", "alongside",
+                                                               "at") else rel
                     q.anchor_category, q.anchor_phrase = stand_in[0], stand_in[1]
                     head = head[: m.start()]
                     break
@@ -840,6 +858,11 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
 
 
 
+#: The end of an order met along a route ("the last lamp", "the final plant", "you reach last").
+_LAST = {"last", "final"}
+_REACHED_LAST = re.compile(r"\b(?:reach|pass|get\s+to|come\s+to|meet|see|walk\s+past)(?:es|ed|s)?\s+(?:last|final)\b")
+
+
 def goal_query(g: GoalParse, embedder: TextEmbedder | None = None) -> ParsedQuery:
     """``ParsedQuery`` of one parsed goal: the mapping reads the words the parse attached to the
     target (``g.core``); the text embedded for similarity is the same words when the parse
@@ -855,6 +878,11 @@ def goal_query(g: GoalParse, embedder: TextEmbedder | None = None) -> ParsedQuer
         # "the third lamp from the door", "the first armchair you reach": an ordinal on the head,
         # counted in the order a route or a predicate gives.
         q.ordinal = next((_ORDINALS[m.lower()] for m in g.modifiers if m.lower() in _ORDINALS), None)
+    if q.ordinal is None and q.proximity is None and q.origin_room is not None and (
+            any(m.lower() in _LAST for m in g.modifiers) or _REACHED_LAST.search(g.core)):
+        # "the last thing on your left coming in", "the lamp you reach last": the end of the
+        # order met from the way in, which the route reverses for "farthest".
+        q.proximity = "farthest"
     if q.generic and not (q.has_attributes or q.ordinal or q.origin_room or q.side):
         q.generic = False  # "the thing" alone says nothing that could pick one object
     if q.room is None:

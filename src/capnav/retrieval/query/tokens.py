@@ -176,7 +176,10 @@ _RELATIONS = [END_OF, "in front of", "facing", "next to", "close to", "beside", 
               # a side of the landmark, as the speaker sees it ("the chair to the left of the desk")
               *(f"{prep}{side} of" for side in ("left", "right", "left-hand side", "right-hand side", "left side",
                                                 "right side", "left hand side", "right hand side")
-                for prep in ("to the ", "on the ", "at the ", "")), "on"]
+                for prep in ("to the ", "on the ", "at the ", "")), "on",
+              # "the stool at the counter", "a seat at the kitchen table": beside it (last, after
+              # every longer relation that starts with it: "at the end of", "at the left of")
+              "at"]
 _MATERIALS = {"wooden", "wood", "leather", "fabric", "velvet", "metal", "glass", "marble", "plastic",
               "ceramic", "stainless", "steel", "laminate", "cotton", "acrylic", "paper", "terracotta", "chrome"}
 #: Every other material word WordNet has, spoken as the material the surface test knows
