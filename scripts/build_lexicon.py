@@ -65,6 +65,10 @@ is spoken to):
   stature clusters' lemmas chosen as the size words are (not the elevation cluster's: it holds
   "under" and "upper"); a word the size table has ("little") stays a size. The retriever compares
   these against the mapped heights, not the volumes.
+- ``widths`` / ``width_superlatives``: words of width -> "large" / "small" and their superlatives:
+  the lemmas of WordNet's adjective of width (``wide.a.01``: wide, broad) and of its antonym
+  (narrow) with their regular -er / -est forms, not their clusters (those hold "panoramic",
+  "tapering"). The retriever compares these against the mapped footprint's longer side.
 - ``growth``: words that name a plant's growth form -> the growth word the captioner measures
   from the points (``capnav.language.form.growth``). A cactus grows as a column narrower than its
   pot, so every lemma of ``cactus.n.01`` and its hyponyms, and of ``succulent.n.01`` itself (the
@@ -215,6 +219,7 @@ def build(wordnet: Path) -> dict[str, Any]:
         noun_exc = (wordnet / "noun.exc").read_text().splitlines()
         out["sizes"] = _sizes(wn, (wordnet / "adj.exc").read_text().splitlines())
         out["heights"], out["height_superlatives"] = _heights(wn, out["sizes"])
+        out["widths"], out["width_superlatives"] = _widths(wn, set(out["sizes"]) | set(out["heights"]))
         out["growth"] = _growth(wn, out["forms"])
         out["labels"] = _labels(wn, out["forms"])
         out["persons"] = _persons(wn, noun_exc)
@@ -225,7 +230,7 @@ def build(wordnet: Path) -> dict[str, Any]:
         out["body"] = _body(wn, noun_exc)
         out["materials"], out["material_nouns"] = _materials(wn, out["forms"], out["labels"])
         out["surface_nouns"] = _surface_nouns(wn)
-        out["part_nouns"] = _part_nouns(wn)
+        out["part_nouns"] = _part_nouns(wn, out["forms"])
         out["rooms"] = _rooms(wn, out["forms"], noun_exc)
         out["attributes"] = _attributes(wn, out)
         out["room_glosses"] = _room_glosses(wn)
@@ -360,6 +365,30 @@ def _heights(wn: Any, sizes: dict[str, str]) -> tuple[dict[str, str], dict[str, 
                 for lemma in _cluster_adjectives(wn, syn):
                     if lemma not in words and lemma not in sizes:
                         words[lemma] = size
+    return dict(sorted(words.items())), dict(sorted(superlative.items()))
+
+
+#: Width: WordNet's adjective of width; its antonym gives the other end (only the two synsets' own
+#: lemmas: the clusters hold "panoramic", "sweeping", "tapering").
+WIDTH_HEAD = "wide.a.01"
+
+
+def _widths(wn: Any, taken: set[str]) -> tuple[dict[str, str], dict[str, str]]:
+    """Width adjectives -> "large" / "small" and superlatives -> "largest" / "smallest" (see the
+    module docstring): wide, broad, narrow, with their regular -er / -est forms; a word another
+    size table holds stays there."""
+    words: dict[str, str] = {}
+    superlative: dict[str, str] = {}
+    up = wn.synset(WIDTH_HEAD)
+    down = next(a.synset() for lem in up.lemmas() for a in lem.antonyms())
+    for size, syn in (("large", up), ("small", down)):
+        for lem in syn.lemmas():
+            word = lem.name()
+            if word in taken or not word.isalpha():
+                continue
+            stem = word[:-1] if word.endswith("e") else word
+            words[word] = words[stem + "er"] = size
+            superlative[stem + "est"] = {"large": "largest", "small": "smallest"}[size]
     return dict(sorted(words.items())), dict(sorted(superlative.items()))
 
 
@@ -545,12 +574,14 @@ def _surface_nouns(wn: Any) -> list[str]:
     return sorted(out | _plurals(out))
 
 
-def _part_nouns(wn: Any) -> list[str]:
+def _part_nouns(wn: Any, forms: dict[str, str]) -> list[str]:
     """Nouns of a piece of an object: the lemmas WordNet lists as parts (part meronyms) of a
     category's synsets or of their hypernyms (arm, back, leg, base, drawer, frame, lampshade, pot),
     whose first noun sense is an artifact or a body part, with their plurals. Words for the whole's
     outline (edge, side, corner, top: locations first) are not among them, so "the sofa with
-    curved edges" keeps its shape and "the armchair with rounded arms" gives it to the arms."""
+    curved edges" keeps its shape and "the armchair with rounded arms" gives it to the arms. A
+    category word is no outline word, so one WordNet lists as a part is a piece whatever its first
+    sense ("seat": seat.n.04, a part of seat.n.03 above chairs and sofas; a place first)."""
     out: set[str] = set()
     for roots in ROOTS.values():
         for n in roots:
@@ -560,8 +591,8 @@ def _part_nouns(wn: Any) -> list[str]:
                     for lem in m.lemmas():
                         w = lem.name()
                         first = wn.synsets(w, "n")
-                        if w.isalpha() and w == w.lower() and first and first[0].lexname() in ("noun.artifact",
-                                                                                              "noun.body"):
+                        if w.isalpha() and w == w.lower() and first and (
+                                first[0].lexname() in ("noun.artifact", "noun.body") or w in forms):
                             out.add(w)
     return sorted(out | _plurals(out))
 
@@ -651,12 +682,24 @@ def _materials(wn: Any, forms: dict[str, str], labels: dict[str, str]) -> tuple[
         for lem in s.lemmas():
             if any(p.synset().name() in by_synset for p in lem.pertainyms()):
                 words.add(lem.name())
+    # A lemma of a root itself names its material whatever the rank of that sense: the root is the
+    # material ("stone" is rock.n.02's lemma, its third noun sense after a lump of rock and a hewn
+    # building stone, both things of stone), when its noun is said more often than its adjective
+    # and its verb in the sense-tagged corpus (stone's adjective is a dull grey colour, tagged 0 times),
+    # and no sense of it lies above another root (fabric.n.01's "material" is also material.n.01: any material).
+    roots = [wn.synset(n) for names in MATERIAL_ROOTS.values() for n in names]
+    above = {h for r in roots for h in r.closure(lambda x: x.hypernyms())} - set(roots)
+    own = {lem.name(): m for m, names in MATERIAL_ROOTS.items() for n in names for lem in wn.synset(n).lemmas()
+           if not above & set(wn.synsets(lem.name(), "n"))}
     out: dict[str, str] = {}
     nouns: dict[str, str] = {}
     for w in sorted(words | (colour_words & words_of_roots())):
         if not w.isalpha() or w != w.lower() or w in forms or w in labels or w in ROOM_WORDS:
             continue
         m = material(w) if w not in colour_words else None
+        if m is None and w in own and w not in colour_words \
+                and count(w, "n") > max(count(w, "v"), count(w, "a") + count(w, "s")):
+            m = own[w]
         if m is not None:
             out[w] = m
         elif (m := material(w, as_noun=True)) is not None:
@@ -716,7 +759,8 @@ def _attributes(wn: Any, lex: dict[str, Any]) -> dict[str, list[str]]:
     from capnav.language.colors import SHADES, canonical_color, color_lab
 
     taken = (set(lex["forms"]) | set(lex["labels"]) | set(lex["materials"]) | set(lex["rooms"]) | set(lex["sizes"])
-             | set(lex["heights"]) | set(lex["height_superlatives"]) | set(lex["growth"]) | set(lex["kinds"])
+             | set(lex["heights"]) | set(lex["height_superlatives"]) | set(lex["widths"]) | set(lex["growth"])
+             | set(lex["kinds"])
              | set(LEXICON) | set(ALIASES) | set(SHADES) | ROOM_WORDS)
     material_synsets = {n: m for m, names in MATERIAL_ROOTS.items() for n in names}
     stop = _english_stop_words()

@@ -149,6 +149,7 @@ class SceneContext:
         size = np.array([o.size for o in self.objects], dtype=np.float64).reshape(n, 3)
         self.volume = np.prod(np.maximum(size, 0.02), axis=1)
         self.height = np.maximum(size[:, 2], 0.02)
+        self.width = np.maximum(np.max(size[:, :2], axis=1), 0.02)  # the footprint's longer side
         # Box-to-box gap in the floor plane (0 when boxes touch or overlap).
         gap = np.maximum(0.0, np.maximum(self.lo[:, None] - self.hi[None], self.lo[None] - self.hi[:, None]))
         self.gap = np.hypot(gap[..., 0], gap[..., 1])

@@ -72,6 +72,10 @@ class Lexicon:
     #: "largest" / "smallest" (WordNet's, see build_lexicon): compared with the mapped heights
     heights: dict[str, str] = field(default_factory=dict)
     height_superlatives: dict[str, str] = field(default_factory=dict)
+    #: a width word ("wide", "broad", "narrower") -> "large" / "small"; "widest", "narrowest" ->
+    #: "largest" / "smallest": compared with the mapped footprint's longer side
+    widths: dict[str, str] = field(default_factory=dict)
+    width_superlatives: dict[str, str] = field(default_factory=dict)
     #: room word -> room type (WordNet's rooms, see build_lexicon): "guest room", "kitchenette"
     rooms: dict[str, str] = field(default_factory=dict)
     #: an adjective WordNet relates to an attribute the map reads -> (kind, value, relation):
@@ -130,6 +134,7 @@ def load_lexicon() -> Lexicon:
                   part_nouns=frozenset(raw.get("part_nouns", [])),
                   heights=dict(raw.get("heights", {})),
                   height_superlatives=dict(raw.get("height_superlatives", {})),
+                  widths=dict(raw.get("widths", {})), width_superlatives=dict(raw.get("width_superlatives", {})),
                   rooms=dict(raw.get("rooms", {})),
                   attributes={k: (v[0], v[1], v[2]) for k, v in raw.get("attributes", {}).items()},
                   room_glosses={k: tuple(v) for k, v in raw.get("room_glosses", {}).items()},

@@ -40,10 +40,11 @@ from capnav.mapping.objects import MapObject
 WOVEN_MATERIALS = frozenset({"fabric", "cotton", "linen", "wool", "woollen", "tweed", "woven", "upholstered"})
 SMOOTH_MATERIALS = frozenset({"leather", "velvet", "metal", "glass", "marble", "plastic", "ceramic", "stainless",
                               "steel", "laminate", "acrylic", "porcelain", "smooth", "glossy", "shiny", "wood",
-                              "wooden", "paper", "terracotta"})
+                              "wooden", "paper", "terracotta", "stone"})
 #: Smooth materials by their grain: wood's stripes and leather's mottle show as grainy; velvet's
 #: pile, plastic, ceramic, acrylic, laminate, glass and paper as plain. Metal's brushed streaks,
-#: marble's veins and terracotta land in between and are judged by the weave only.
+#: marble's veins and terracotta land in between and are judged by the weave only; so is stone
+#: (WordNet's rock.n.02, above marble, granite and slate), as marble is.
 GRAINED_MATERIALS = frozenset({"wood", "wooden", "leather"})
 PLAIN_MATERIALS = frozenset({"velvet", "plastic", "ceramic", "porcelain", "acrylic", "laminate", "glass", "paper"})
 

@@ -332,20 +332,26 @@ class OfflineVerifier(Verifier):
     def size(self, q: ParsedQuery, obj: MapObject) -> float:
         """1 when the object is the size the query says among its category, 0 when the opposite,
         0.5 when the category's mapped volumes are too close to tell (``size_ratio``). A word of
-        height ("the tall lamp") is judged on the mapped heights, at the same linear tolerance
-        (the cube root of the volume ratio)."""
+        height ("the tall lamp") is judged on the mapped heights, one of width ("the narrow
+        wardrobe") on the footprints' longer sides, at the same linear tolerance (the cube root of
+        the volume ratio)."""
         if q.size_word is None or self.scene is None or obj.id not in self.scene.index:
             return 0.0
+        said = [(q.size_word, q.size_axis), *q.more_sizes]  # "tall narrow": each on its own measure
+        return float(np.mean([self._size_along(word, axis, obj) for word, axis in said]))
+
+    def _size_along(self, word: str, axis: str | None, obj: MapObject) -> float:
+        assert self.scene is not None
         peers = [self.scene.index[o.id] for o in self.scene.same_label(obj)]
-        height = q.size_axis == "height"
-        measure = self.scene.height if height else self.scene.volume
-        ratio = self.config.size_ratio ** (1.0 / 3.0) if height else self.config.size_ratio
+        linear = axis in ("height", "width")
+        measure = self.scene.height if axis == "height" else self.scene.width if linear else self.scene.volume
+        ratio = self.config.size_ratio ** (1.0 / 3.0) if linear else self.config.size_ratio
         vols = np.sort(measure[peers])
         if len(vols) < 2 or vols[-1] < ratio * vols[0]:
             return 0.5
         v = float(measure[self.scene.index[obj.id]])
         frac = float(np.log(v / vols[0]) / np.log(vols[-1] / vols[0]))  # 0 smallest .. 1 largest
-        return frac if q.size_word == "large" else 1.0 - frac
+        return frac if word == "large" else 1.0 - frac
 
     def assess(self, query: ParsedQuery, c: Candidate, position: float = 0.0) -> Assessment:
         """Judge one candidate; ``position`` in [0, 1) is its place in the batch (0 = first).

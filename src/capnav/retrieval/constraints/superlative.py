@@ -1,5 +1,6 @@
 """A superlative of size ("the biggest armchair"): the mapped volume orders the candidates; of
-height ("the tallest lamp", "the lowest table"), the mapped height."""
+height ("the tallest lamp", "the lowest table"), the mapped height; of width ("the widest
+wardrobe", "the narrowest bookcase"), the footprint's longer side."""
 
 from __future__ import annotations
 
@@ -21,6 +22,8 @@ class Superlative(RankingConstraint):
             return
         if st.q.size_axis == "height":
             vol, what = st.r.scene.height[st.pool], "height (m)"
+        elif st.q.size_axis == "width":
+            vol, what = st.r.scene.width[st.pool], "width (m)"
         else:
             vol, what = st.r.volume[st.pool], "volume (m3)"
         st.group_keys.append(-vol if st.q.superlative == "largest" else vol)

@@ -55,6 +55,7 @@ from capnav.retrieval.query.tokens import (
     material_of,
     materials_in,
     size_axis,
+    size_words,
     validate_instruction,
 )
 
@@ -493,6 +494,19 @@ _HAVING = {"with", "has", "having", "have"}
 _PART_DETERMINERS = {"a", "an", "the", "its", "their", "some", "two", "three", "four"}
 
 
+def _own_piece(part: str, before: list[str]) -> bool:
+    """A category word after "with" is a piece of the target, not another object, when WordNet
+    lists it as a part (the lexicon's ``part_nouns``) and it names the target's own category or
+    one that may stand in for it: "a chair with a velvet seat" (seat.n.04, a part of seat.n.03 above
+    chairs and sofas), "the sofa with the leather seats"; "the counter with the wooden stool" is a
+    stool beside it (a stool is a part only of a toilet in WordNet, and no counter's stand-in)."""
+    head = _find_category(before)[0]
+    named = _find_category([part])[0]
+    if head is None or named is None or part not in _LEX.part_nouns:
+        return False
+    return named == head or named in _LEX.category_alternatives(head, None)
+
+
 def _without_parts(q: ParsedQuery, words: list[str]) -> list[str]:
     """``words`` without the materials and shapes said of a part ("the dresser with the glass top":
     glass is the top's; "rounded arms"), which go to ``q.part_materials`` / ``q.part_shapes`` with a
@@ -517,7 +531,7 @@ def _without_parts(q: ParsedQuery, words: list[str]) -> list[str]:
             continue
         part = words[j]
         if not part.isalpha() or part in _FILLER or part in _HAVING or part in _LEX.surface_nouns \
-                or _find_category([part])[0] is not None:
+                or (_find_category([part])[0] is not None and not _own_piece(part, words[:k])):
             continue
         mats = materials_in(words[mods:j])
         shapes = list(dict.fromkeys(_SHAPES[w] for w in words[mods:j] if w in _SHAPES)) \
@@ -572,6 +586,7 @@ def _attributes_outside(q: ParsedQuery, head: str, activity: str) -> None:
     q.shapes = _shapes(words)
     q.materials = materials_in(words)
     q.size_word, q.size_axis = _size_word(words)
+    q.more_sizes = [(s, a) for s, a in size_words(words) if a != q.size_axis]
 
 
 def _count(q: ParsedQuery, head: str) -> str:
@@ -754,6 +769,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
             break
     if q.superlative is None:
         q.size_word, q.size_axis = _size_word(words)
+        q.more_sizes = [(s, a) for s, a in size_words(words) if a != q.size_axis]
     else:
         q.size_word = _size_word(words)[0]
     q.colors = _colors(words)

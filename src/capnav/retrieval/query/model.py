@@ -25,7 +25,10 @@ class ParsedQuery:
     shapes: list[str] = field(default_factory=list)
     size_word: str | None = None  # "large" / "small"
     superlative: str | None = None  # "largest" / "smallest"
-    size_axis: str | None = None  # what the size word or superlative measures: "height" ("tall"), None: volume
+    size_axis: str | None = None  # what the size word or superlative measures: "height" ("tall"), "width", None: volume
+    #: Size words of the other dimensions said with the first ("the tall narrow bookcase": small by
+    #: width), as (size, axis): judged with it, each on its own measure.
+    more_sizes: list[tuple[str, str | None]] = field(default_factory=list)
     proximity: str | None = None  # "closest" / "farthest"
     relation: str | None = None  # "next to", ...
     anchor_category: str | None = None

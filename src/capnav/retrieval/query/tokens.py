@@ -135,8 +135,10 @@ def nearly_named(text: str, category: str) -> str | None:
 
 _PROXIMITY = {"closest": "closest", "nearest": "closest", "near me": "closest", "closest to me": "closest",
               "farthest": "farthest", "furthest": "farthest", "most distant": "farthest"}
-_SUPERLATIVE = {"biggest": "largest", "largest": "largest", "largest one": "largest", "widest": "largest",
-                "smallest": "smallest", "tiniest": "smallest", "littlest": "smallest", "narrowest": "smallest"}
+_SUPERLATIVE = {"biggest": "largest", "largest": "largest", "largest one": "largest",
+                "smallest": "smallest", "tiniest": "smallest", "littlest": "smallest"}
+#: "widest", "narrowest", "broadest" (the lexicon's ``width_superlatives``): by the footprint's longer side.
+_SUPERLATIVE.update(_LEX.width_superlatives)
 #: "tallest", "lowest" (the lexicon's ``height_superlatives``): ordered by the mapped height.
 _SUPERLATIVE.update(_LEX.height_superlatives)
 _SIZE_WORDS = {"big": "large", "large": "large", "huge": "large", "larger": "large", "bigger": "large",
@@ -147,6 +149,11 @@ _SIZE_WORDS.update(_LEX.sizes)
 #: the mapped heights of the category rather than the volumes. A size word of both tables stays a size.
 _SIZE_WORDS.update({w: s for w, s in _LEX.heights.items() if w not in _SIZE_WORDS})
 _HEIGHT_WORDS = {w for w in _LEX.heights if w not in _LEX.sizes} | set(_LEX.height_superlatives)
+#: Words of width ("wide", "narrow", "broader"; the lexicon's ``widths``): compared with the mapped
+#: footprint's longer side ("the narrow wardrobe" of a two-door and a three-door one).
+_SIZE_WORDS.update({w: s for w, s in _LEX.widths.items() if w not in _SIZE_WORDS})
+_WIDTH_WORDS = {w for w in _LEX.widths if w not in _LEX.sizes and w not in _LEX.heights} \
+    | set(_LEX.width_superlatives)
 _SIZE_TOKENS = {w for f in _SIZE_WORDS for w in f.split()}
 _SHAPES = {"round": "round", "circular": "round", "l-shaped": "L-shaped", "l shaped": "L-shaped",
            "corner": "L-shaped", "long": "long", "rectangular": "rectangular", "square": "square",
@@ -489,9 +496,26 @@ def _size_word(words: list[str]) -> tuple[str | None, str | None]:
     return None, None
 
 
+def size_words(words: list[str]) -> list[tuple[str, str | None]]:
+    """Every dimension a size word says, the first word of each ("the tall narrow bookcase":
+    large by height, small by width), in the order said; the first is ``_size_word``'s."""
+    out: dict[str | None, str] = {}
+    rest = list(words)
+    while True:
+        size, axis = _size_word(rest)
+        if size is None:
+            return [(s, a) for a, s in out.items()]
+        out.setdefault(axis, size)
+        k = next(i for i in range(len(rest)) if any(" ".join(rest[i:i + n]) in _SIZE_WORDS
+                                                    and _SIZE_WORDS[" ".join(rest[i:i + n])] == size
+                                                    and size_axis(" ".join(rest[i:i + n])) == axis for n in (2, 1)))
+        rest = rest[k + 1:]
+
+
 def size_axis(word: str) -> str | None:
-    """What a size word or superlative measures: "height" ("tall", "lowest"), or None for the volume."""
-    return "height" if word in _HEIGHT_WORDS else None
+    """What a size word or superlative measures: "height" ("tall", "lowest"), "width" ("narrow",
+    "widest": the footprint's longer side), or None for the volume."""
+    return "height" if word in _HEIGHT_WORDS else "width" if word in _WIDTH_WORDS else None
 
 
 def _other_object(words: list[str], span: tuple[int, int] | None) -> str | None:
