@@ -25,7 +25,7 @@ PIP=("$VENV/bin/python" -m pip install --quiet --disable-pip-version-check)
 if [ "$DEV" = 1 ]; then
   # CPU build of PyTorch first, so that sentence-transformers/transformers do not pull a CUDA build.
   "${PIP[@]}" "torch==2.13.0"
-  "${PIP[@]}" -e ".[dev,bge,vlm,detect,coco,gemini,openai,ray,ros,serve,viz]"
+  "${PIP[@]}" -e ".[dev,bge,vlm,detect,coco,gemini,openai,ray,ros,serve,viz,register]"
 else
   "${PIP[@]}" -e .
 fi

@@ -171,7 +171,8 @@ def _check_old_format_loads(tmp_path: Path, m1: CapNavMap) -> None:
 
 
 def test_registration_of_offset_frames(visits: dict[str, Path]) -> None:
-    pytest.importorskip("open3d")
+    pytest.importorskip("open3d", exc_type=ImportError,
+                        reason="open3d (extra register) or a system library it needs (libusb-1.0-0) is missing")
     m1 = load_map(visits["m1.capnav"])
     reg = register_recording(m1, DatasetReader(visits["v2off"]), "v2off")
     from capnav.sim.record import planar_pose
@@ -294,3 +295,24 @@ def test_questions_about_time_answer_from_the_latest_state(visits: dict[str, Pat
         res = r.query(f"the {o.label}")
         assert res.chosen is None or res.chosen.id not in {g.id for g in m2.retired}
     assert not Retriever(m1, emb)._time  # a one-recording map reads requests exactly as before
+
+
+def test_identity_scorer_reads_ids_from_points_not_from_the_simulator(visits: dict[str, Path]) -> None:
+    """``eval.update_identity`` matches both maps to the truth by their points (a COCO model's map
+    carries no instance ids): the oracle update is right in every class, and the same map with a
+    moved object's id changed is scored as reborn, not kept."""
+    from capnav.eval.update_identity import identity_report
+
+    m1 = load_map(visits["m1.capnav"])
+    m2, rep = update_map(m1, DatasetReader(visits["v2"]), _det(), _enc(), progress=False)
+    t1, t2 = (SceneManifest.load(visits[k] / "manifest.json") for k in ("v1", "v2"))
+    score = identity_report(m1, m2, t1, t2)
+    for cls in ("moved", "removed", "added"):
+        ok, n = score.right(cls)
+        assert n > 0 and ok == n, (cls, score.counts)
+    ok, n = score.right("unchanged")
+    assert ok == n and n >= 5, score.counts
+    renamed = next(o for o in m2.objects if o.id in rep.moved)
+    renamed.id = 999
+    again = identity_report(m1, m2, t1, t2)
+    assert again.counts["moved"]["reborn"] == 1 and again.right("moved")[0] == score.right("moved")[0] - 1

@@ -15,7 +15,7 @@ truth's apartment area.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -127,6 +127,19 @@ def occupancy_iou(pred: OccupancyGrid, truth: OccupancyGrid) -> float | None:
     return float((a & b).sum()) / union if union else None
 
 
+def match_objects(objects: Sequence[MapObject], instances: Sequence[ObjectInstance],
+                  config: QualityConfig | None = None) -> list[int | None]:
+    """Per map object, the id of the instance whose box (grown by ``box_margin``) holds the largest
+    share of its points, if that share is at least ``min_inside``; else None."""
+    cfg = config or QualityConfig()
+    out: list[int | None] = []
+    for o in objects:
+        shares = [float(inside_box(o.points, g, cfg.box_margin).mean()) for g in instances] if len(o.points) else []
+        j = int(np.argmax(shares)) if shares else -1
+        out.append(instances[j].id if j >= 0 and shares[j] >= cfg.min_inside else None)
+    return out
+
+
 def evaluate_map(cmap: CapNavMap, manifest: SceneManifest, seen: dict[int, int] | None = None,
                  truth_occupancy: OccupancyGrid | None = None, config: QualityConfig | None = None
                  ) -> MappingQuality:
@@ -134,21 +147,18 @@ def evaluate_map(cmap: CapNavMap, manifest: SceneManifest, seen: dict[int, int] 
     instance counts as seen."""
     cfg = config or QualityConfig()
     insts = manifest.objects
+    by_id = {g.id: g for g in insts}
     match: dict[int, list[int]] = {i.id: [] for i in insts}
     unmatched: list[dict[str, Any]] = []
     correct = matched = 0
-    for k, o in enumerate(cmap.objects):
-        if len(o.points) == 0:
-            unmatched.append({"object": o.id, "label": o.label})
+    for k, (o, j) in enumerate(zip(cmap.objects, match_objects(cmap.objects, insts, cfg), strict=True)):
+        if j is None:
+            unmatched.append({"object": o.id, "label": o.label}
+                             | ({"position": o.position.round(2).tolist()} if len(o.points) else {}))
             continue
-        shares = [float(inside_box(o.points, g, cfg.box_margin).mean()) for g in insts]
-        j = int(np.argmax(shares)) if shares else -1
-        if j < 0 or shares[j] < cfg.min_inside:
-            unmatched.append({"object": o.id, "label": o.label, "position": o.position.round(2).tolist()})
-            continue
-        match[insts[j].id].append(k)
+        match[j].append(k)
         matched += 1
-        correct += int(o.label == insts[j].category)
+        correct += int(o.label == by_id[j].category)
     seen_ids = [i.id for i in insts if seen is None or seen.get(i.id, 0) >= cfg.min_frames]
     per: list[dict[str, Any]] = []
     errors: list[float] = []
