@@ -201,3 +201,29 @@ def test_part_of_a_retired_objects_surface_its_masks_missed_goes_with_it() -> No
         assert occ.cells[r, c] == FREE, f"the retired chair's place is still an obstacle at {xy}"
     wall = occ.spec.to_cell(np.array([[2.95, 0.0]]))[0]
     assert occ.cells[wall[0], wall[1]] != FREE
+
+
+@pytest.mark.parametrize("shed", [True, False])
+def test_a_fused_neighbour_carried_off_leaves_the_box_of_what_stays(shed: bool) -> None:
+    """A real detector can fuse two pieces standing side by side into one object (Yolo-Fastest took a
+    sofa and the armchair beside it for one 3 m "chair"). Here the first map holds such an object
+    (two boxes of one instance); the sofa part is carried off. The armchair part, seen again in
+    place, keeps the id and sheds the sofa's points, whose space was seen empty: its box is the
+    armchair's. Without shedding it keeps a 2.6 m box over empty floor."""
+    from capnav.mapping.update import UpdateConfig
+
+    armchair = _box(2.2, 1.0, 0.8, 0.8, 0.9, 1, ARMCHAIR, PINK)
+    sofa_part = _box(2.2, -0.2, 0.8, 1.6, 0.9, 1, ARMCHAIR, PINK)  # same instance: one object in map 1
+    m1 = _map(_orbit([_table(), armchair, sofa_part]))
+    fused = _at(m1.objects, (2.2, 0.2), 0.5)
+    assert len(fused) == 1 and fused[0].extent_max[1] - fused[0].extent_min[1] > 2.2
+    m2, rep = update_map(m1, _Frames(_orbit([_table(), armchair]), "visit2"), create_detector("sim", noise="oracle"),
+                         _enc(), config=UpdateConfig(shed=shed), progress=False)
+    o = {x.id: x for x in m2.objects}[fused[0].id]
+    side = float(o.extent_max[1] - o.extent_min[1])
+    if shed:
+        assert side < 1.1 and abs(o.position[1] - 1.0) < 0.2, (side, o.position, rep.summary())
+        assert rep.shrunk == [o.id] and o.history[-1]["event"] == "shrunk"
+        assert rep.retired == [] and rep.moved == []
+    else:
+        assert side > 2.2 and rep.shrunk == []

@@ -46,6 +46,9 @@ def describe_event(e: dict[str, Any], recs: dict[int, dict[str, Any]]) -> str:
         return f"moved from ({fr[0]:.2f}, {fr[1]:.2f}) to {at} in {when}"
     if e.get("event") == "retired":
         return f"gone from {at} in {when} (its place seen empty in {e.get('frames_empty', '?')} frames)"
+    if e.get("event") == "shrunk":
+        return (f"smaller in {when}: {e.get('points_seen_empty', '?')} of its points were seen empty "
+                f"(now centred at {at})")
     return f"first seen at {at} in {when}"
 
 

@@ -72,7 +72,15 @@ class UpdateConfig:
     ``same_radius`` of that object's points (labels compatible); a moved one when its likeness
     to an object observed empty (descriptor cosine, colour, size) is at least ``min_likeness``;
     one assignment decides all of them, a pair at the same place counting ``place_prior`` more.
-    New objects need ``min_hits`` detections to be born."""
+    New objects need ``min_hits`` detections to be born.
+
+    Shedding: an object that stays sheds the points whose space was seen empty by the same rule
+    (per point), when they are at least ``shed_min`` of its points, ``shed_keep`` remain above the
+    floor and a side of its box shrinks by ``shed_side`` (a lamp's pole or a sink's rim seen past
+    in a few frames, 10% of their points, changes no box: left as it was); its floor-level points
+    stay only within ``shed_floor_radius`` of what remains. A
+    neighbour the first map fused into it and that was carried off leaves its box (a 3 m "chair"
+    of a sofa and an armchair, Yolo-Fastest, docs/change.md)."""
 
     tol: float = 0.08
     margin: float = 0.15
@@ -97,6 +105,11 @@ class UpdateConfig:
     min_likeness: float = 0.55
     place_prior: float = 0.3
     min_hits: int = 3
+    shed: bool = True
+    shed_min: float = 0.25
+    shed_keep: float = 0.2
+    shed_side: float = 0.15
+    shed_floor_radius: float = 0.1
     register: RegisterConfig = field(default_factory=RegisterConfig)
 
 
@@ -111,6 +124,7 @@ class UpdateReport:
     retired: list[int] = field(default_factory=list)
     born: list[int] = field(default_factory=list)
     unobserved: list[int] = field(default_factory=list)  # old objects the recording did not see
+    shrunk: list[int] = field(default_factory=list)  # old objects that shed points seen empty
     voxels_carved: int = 0
     cpu_seconds: float = 0.0
     registration: dict[str, Any] = field(default_factory=dict)
@@ -124,7 +138,8 @@ class UpdateReport:
     def summary(self) -> str:
         return (f"recording {self.recording}: {len(self.present)} objects confirmed, {len(self.moved)} moved "
                 f"{self.moved}, {len(self.retired)} retired {self.retired}, {len(self.born)} new {self.born}, "
-                f"{len(self.unobserved)} not in view; detector ran on {self.frames_detected} of {self.frames} "
+                f"{len(self.unobserved)} not in view, {len(self.shrunk)} shrunk to what was still there; "
+                f"detector ran on {self.frames_detected} of {self.frames} "
                 f"frames (depth alone fused in {self.frames_depth_only}); {self.voxels_carved} voxels carved free")
 
 
@@ -255,27 +270,74 @@ class _Evidence:
     owner: NDArray[np.int64]  # index into the old objects of each point
     n: int
     colour: NDArray[np.float64]  # (n, 3) each object's mean colour
+    source: NDArray[np.int64]  # index of each point in its object's own points
     present: NDArray[np.int64] = field(init=False)
     empty: NDArray[np.int64] = field(init=False)
     last_present: NDArray[np.int64] = field(init=False)
+    point_seen: NDArray[np.int64] = field(init=False)  # per point: frames that saw it
+    point_through: NDArray[np.int64] = field(init=False)  # per point: frames that saw past it
 
     def __post_init__(self) -> None:
         self.present = np.zeros(self.n, np.int64)
         self.empty = np.zeros(self.n, np.int64)
         self.last_present = np.full(self.n, -1, np.int64)
+        self.point_seen = np.zeros(len(self.points), np.int64)
+        self.point_through = np.zeros(len(self.points), np.int64)
+
+    def vanished(self, q: int, cfg: UpdateConfig) -> NDArray[np.int64]:
+        """Indices into object ``q``'s points whose space was seen empty, by the rule that retires
+        a whole object (``min_empty_frames``, twice as often as seen)."""
+        sel = self.owner == q
+        thr, seen = self.point_through[sel], self.point_seen[sel]
+        return self.source[sel][(thr >= cfg.min_empty_frames) & (thr >= 2 * seen)]
 
 
 def _object_evidence(objects: list[MapObject], cfg: UpdateConfig) -> _Evidence:
-    pts, own = [], []
+    pts, own, src = [], [], []
     for k, o in enumerate(objects):
-        p = np.asarray(o.points, dtype=np.float64)
-        p = p[p[:, 2] >= cfg.floor_clearance] if len(p) else p
-        pts.append(p)
-        own.append(np.full(len(p), k, np.int64))
+        p = np.asarray(o.points, dtype=np.float64).reshape(-1, 3)
+        idx = np.flatnonzero(p[:, 2] >= cfg.floor_clearance)
+        pts.append(p[idx])
+        own.append(np.full(len(idx), k, np.int64))
+        src.append(idx.astype(np.int64))
     colour = np.array([np.asarray(o.colors, np.float64).mean(axis=0) if len(o.colors) else np.full(3, np.nan)
                        for o in objects]).reshape(-1, 3)
     return _Evidence(np.concatenate(pts) if pts else np.zeros((0, 3)), np.concatenate(own) if own else
-                     np.zeros(0, np.int64), len(objects), colour)
+                     np.zeros(0, np.int64), len(objects), colour,
+                     np.concatenate(src) if src else np.zeros(0, np.int64))
+
+
+def _shed(o: MapObject, vanished: NDArray[np.int64], cfg: UpdateConfig, percentile: float) -> MapObject | None:
+    """``o`` without the points whose space was seen empty, its box and footprint taken again; None
+    when it keeps too few (``shed_keep``), or sheds too few (``shed_min``) or too little of its box
+    (``shed_side``) to matter. A piece the
+    first map fused into it and that left (a sofa beside an armchair, mapped as one "chair") goes
+    with its points; the depth evidence is the same that retires whole objects."""
+    n = len(o.points)
+    if n == 0 or len(vanished) < cfg.shed_min * n:
+        return None
+    keep = np.ones(n, bool)
+    keep[vanished] = False
+    p = np.asarray(o.points, np.float64)
+    up = keep & (p[:, 2] >= cfg.floor_clearance)
+    if up.sum() < cfg.shed_keep * n or up.sum() < cfg.min_points:
+        return None
+    # its floor-level points go with the space above them: kept only under what stays
+    if (~up & keep).any():
+        d, _ = cKDTree(p[up, :2]).query(p[~up & keep, :2], distance_upper_bound=cfg.shed_floor_radius)
+        keep[np.flatnonzero(~up & keep)[~np.isfinite(d)]] = False
+    from capnav.mapping.memory import footprint
+
+    c = copy.copy(o)
+    c.points, c.colors = o.points[keep].copy(), o.colors[keep].copy()
+    q = np.asarray(c.points, np.float64)
+    lo, hi = np.percentile(q, percentile, axis=0), np.percentile(q, 100.0 - percentile, axis=0)
+    inside = np.all((q[:, :2] >= lo[:2]) & (q[:, :2] <= hi[:2]), axis=1)
+    if not ((o.extent_max - o.extent_min)[:2] - (hi - lo)[:2] >= cfg.shed_side).any():
+        return None
+    c.extent_min, c.extent_max, c.position = lo, hi, (lo + hi) / 2.0
+    c.footprint = footprint(q[inside, :2] if inside.sum() >= 3 else q[:, :2])
+    return c
 
 
 # ---- matching ------------------------------------------------------------------------------
@@ -458,6 +520,8 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
             empty = spoke & (thr >= cfg.empty_share * (seen + thr))
             here = spoke & (seen >= cfg.present_share * (seen + thr))
             ev.empty += empty
+            ev.point_seen += codes == E_.SEEN
+            ev.point_through += codes == E_.THROUGH
             emptied = bool(empty.any())
             recoloured = bool(cfg.recolour > 0) and _recoloured(f, Tcw, ev, codes == E_.SEEN, here, cfg)
             ev.present += here
@@ -545,6 +609,13 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
             retired.append(c)
             rep.retired.append(o.id)
         else:
+            shed = _shed(c, ev.vanished(q, cfg), cfg, mapper.config.memory.extent_percentile) if cfg.shed else None
+            if shed is not None:
+                c = shed
+                c.history = [*c.history, {"recording": k, "event": "shrunk",
+                                          "position": np.round(c.position, 3).tolist(),
+                                          "points_seen_empty": int(len(o.points) - len(c.points))}]
+                rep.shrunk.append(o.id)
             if seen_again[q]:
                 last = int(ev.last_present[q])
                 claimed_by = [new_objs[j] for j, qq in claimed.items() if qq == q]
