@@ -116,6 +116,11 @@ class AttributeConstraint(ABC):
     kind: str
     order: int
     weight_field: str  # the ``OfflineVerifierConfig`` weight of its agreement
+    #: Whether its ``supported`` evidence is the map showing the attribute outright (a grain, an
+    #: outline word), not a graded fit: such evidence puts a candidate before those of its predicate
+    #: group on which the map cannot tell, ahead of the retrieval order (colour and size are graded
+    #: and weigh in through their agreement instead).
+    shown: bool = False
 
     @staticmethod
     @abstractmethod

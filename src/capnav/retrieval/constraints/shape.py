@@ -25,6 +25,7 @@ class Shape(AttributeConstraint):
     kind = "shape"
     order = 40
     weight_field = "w_shape"
+    shown = True
 
     @staticmethod
     def applies(q: ParsedQuery) -> bool:
