@@ -494,6 +494,31 @@ _HAVING = {"with", "has", "having", "have"}
 _PART_DETERMINERS = {"a", "an", "the", "its", "their", "some", "two", "three", "four"}
 
 
+#: "... at it", "... next to it", "... around them": the pronoun that points back at the target.
+_BACK_TO_TARGET = re.compile(r"\s+(?:at|by|next to|beside|around|round|in front of|near|under|in|on)\s+(?:it|them)\s*$")
+
+
+def _with_landmark(q: ParsedQuery, head: str) -> str:
+    """"the desk with the blue chair at it", "the table that has the green stools round it": a
+    category after "with" / "that has" that is no piece of the target (``_own_piece``: "a chair
+    with a velvet seat" is) is another object beside it, a landmark "next to" the target, and
+    the words said of it (blue, green) are the landmark's, not the target's. Returns ``head``
+    without the phrase."""
+    m = re.search(r"\b(?:with|(?:that|which)\s+(?:has|have)|having)\s+(?:the\s+|a\s+|an\s+|some\s+|its\s+)?(.+)$",
+                  head)
+    if m is None or m.start() == 0:
+        return head
+    before = head[:m.start()].split()
+    anchor = _BACK_TO_TARGET.sub("", m.group(1)).strip()
+    words = anchor.split()
+    target, _, _ = _find_category(before)
+    cat, span, _ = _find_category(words)
+    if target is None or cat is None or span is None or _own_piece(words[span[1] - 1], before):
+        return head
+    q.relation, q.anchor_category, q.anchor_phrase = "next to", cat, anchor
+    return head[:m.start()].strip()
+
+
 def _own_piece(part: str, before: list[str]) -> bool:
     """A category word after "with" is a piece of the target, not another object, when WordNet
     lists it as a part (the lexicon's ``part_nouns``) and it names the target's own category or
@@ -762,6 +787,9 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                     q.anchor_phrase = m.group(1)
                     head = head[:m.start()]
                     break
+    # "the desk with the blue chair at it": another object the target has by it, a landmark.
+    if q.anchor_category is None:
+        head = _with_landmark(q, head)
     words = _joined_compounds([w for w in re.split(r"\s+", head.strip()) if w])
     for phrase in sorted(_SUPERLATIVE, key=len, reverse=True):
         if phrase in head and re.search(rf"\b{phrase}\b", head):
