@@ -388,8 +388,8 @@ class OfflineVerifier(Verifier):
                 rejects.append(v.reason)
                 continue
             # The lowest predicate group first; within it the candidates the map shows a stated
-            # material or shape on (``AttributeConstraint.shown``) before those it cannot tell
-            # about, then the highest value.
+            # material on (``AttributeConstraint.shown``) before those it cannot tell about, then
+            # the highest value.
             seen = shown_count(v.evidence)
             if best is None or (c.group, -seen, -v.value) < (best[0], -best[1], -best[2]):
                 best = (c.group, seen, v.value, i, v.reason)

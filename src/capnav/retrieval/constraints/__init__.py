@@ -52,7 +52,7 @@ def attribute_constraints(q: ParsedQuery) -> list[AttributeConstraint]:
 
 def shown_kinds(evidence: list[Evidence]) -> list[str]:
     """The stated attributes the map shows outright on a candidate (``supported`` evidence of a
-    kind whose support is an observation, ``AttributeConstraint.shown``: a grain, an outline)."""
+    kind whose support is an observation, ``AttributeConstraint.shown``: a material's grain)."""
     shown = {c.kind for c in ATTRIBUTES if c.shown}
     return [e.kind for e in evidence if e.kind in shown and e.status == SUPPORTED]
 
