@@ -37,6 +37,8 @@ def flat() -> Retriever:
      "go and see", DESK),
     ("I was working at the desk all morning and then had a rest on the sofa, I reckon my pen rolled "
      "under the bed though, please check there", BED),
+    ("the cat was asleep on the bed and then she jumped down, I guess she knocked my earring behind the tv, "
+     "go and have a look", TV),
 ])
 def test_a_past_story_with_then_is_one_goal(flat: Retriever, text: str, oid: int) -> None:
     goals = parse_goals(text)

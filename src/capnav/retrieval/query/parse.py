@@ -554,12 +554,17 @@ def _pointer_referent(doc: Doc, ask: set[int], mentions: list[tuple[int, int, st
 
 def _says_where(v: Token) -> bool:
     """Whether the clause of verb ``v`` says where a thing is or was put: a placing verb ("left",
-    "dropped"), or a clause not told in the past ("it is hiding under the desk", "my keys might be
-    on the counter")."""
+    "put"), a clause not told in the past ("it is hiding under the desk", "my keys might be on the
+    counter"), or what the speaker says they believe happened ("I think she knocked it behind the
+    sofa")."""
     if v.pos_ not in ("VERB", "AUX"):
         return False
     past = v.tag_ in _PAST_TAGS or any(c.dep_ in ("aux", "auxpass") and c.tag_ in _PAST_TAGS for c in v.children)
-    return _placing_verb(v) or not past
+    # "I think he dropped his car under the table": a past event the speaker now says, in the
+    # present, they believe: where the thing is now.
+    guessed = v.dep_ == "ccomp" and v.head.tag_ in ("VBP", "VBZ") and any(
+        c.dep_ == "nsubj" and c.lower_ in ("i", "we") for c in v.head.children)
+    return _placing_verb(v) or not past or guessed
 
 
 def _clause_verb(t: Token) -> int:
