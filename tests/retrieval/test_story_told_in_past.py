@@ -59,6 +59,15 @@ def test_a_story_that_only_points_back_asks_for_what_it_points_at(flat: Retrieve
     assert res.found and res.chosen is not None and res.chosen.id == oid, res.reason
 
 
+@pytest.mark.parametrize(("text", "oid"), [
+    ("I had a snooze on the sofa after lunch, but what I'm after now is the fridge", FRIDGE),
+    ("the kids were jumping on the bed all day and what I want is the desk", DESK),
+])
+def test_a_story_that_ends_by_naming_what_is_wanted(flat: Retriever, text: str, oid: int) -> None:
+    res = query_goals(flat, text).results[0]
+    assert res.found and res.chosen is not None and res.chosen.id == oid, res.reason
+
+
 @pytest.mark.parametrize("text", [
     "go to the fridge and then the sofa",
     "I'd like to see the tv and then the bed",

@@ -586,9 +586,11 @@ def _request_clause(doc: Doc, mentions: list[tuple[int, int, str]]) -> set[int] 
     tells a story that names an object or an attribute. None when the whole text is the ask."""
     asking = [v for v in reversed(doc) if _asks(v)]
     if not asking:
-        # A story that ends without asking but says where a thing is by pointing back ("..., I sat
-        # at the desk, my phone must still be on it"): its last clause is the ask.
-        asking = [t for t in reversed(doc) if t.dep_ == "ROOT" and t.pos_ in ("VERB", "AUX")][:1]
+        # A story that ends without asking, in a clause not told in the past: one that says where
+        # a thing is by pointing back ("..., I sat at the desk, my phone must still be on it") or
+        # names what is wanted ("..., but what I need now is the ottoman"): that clause is the ask.
+        asking = [t for t in reversed(doc) if t.dep_ in ("ROOT", "conj", "parataxis") and t.pos_ in ("VERB", "AUX")
+                  and t.tag_ not in _PAST_TAGS][:1]
     for v in asking:
         # "pop over there and check": the second of two coordinated asks (the parser may not
         # take the first for a verb) points back together with the first, unless that one tells
