@@ -533,11 +533,12 @@ def _pointer_referent(doc: Doc, ask: set[int], mentions: list[tuple[int, int, st
     if not heads:
         return None
     # A bare ask ("can you go and check", "go and see") points back as "there" does when the
-    # story's last object is where something is now or was put ("I think she left her bag by
-    # the bath", "it is hiding under the desk"), not where something only happened ("we watched
-    # a film on the sofa").
-    if not points and not _says_where(doc[_clause_verb(heads[-1])]):
-        return None
+    # story's last clause is told by someone (not said to the robot) and says where a thing is now
+    # or was put ("I think she left her bag by the bath", "it is hiding under the desk"), not where
+    # something only happened ("we watched a film on the sofa").
+    told = doc[_clause_verb(heads[-1])]
+    if not points and not (_tells(told) and _says_where(told)):
+        return None  # "if you begin at the cooker and work along": an instruction, no story
     # The place the last telling clause names first ("it was on the counter with the sink": the
     # counter; the sink, however the parser hangs it, is its landmark).
     # The rest of that clause from there on says which one ("on the desk in there, not the one in
