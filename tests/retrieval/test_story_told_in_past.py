@@ -39,6 +39,9 @@ def flat() -> Retriever:
      "under the bed though, please check there", BED),
     ("the cat was asleep on the bed and then she jumped down, I guess she knocked my earring behind the tv, "
      "go and have a look", TV),
+    # a thing the map does not hold, where it is or was lost; then a bare ask
+    ("there's a wasp buzzing round behind the fridge, go and see", FRIDGE),
+    ("my daughter lost a sock somewhere under the desk, can you go and check", DESK),
 ])
 def test_a_past_story_with_then_is_one_goal(flat: Retriever, text: str, oid: int) -> None:
     goals = parse_goals(text)

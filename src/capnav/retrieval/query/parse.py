@@ -533,12 +533,11 @@ def _pointer_referent(doc: Doc, ask: set[int], mentions: list[tuple[int, int, st
     if not heads:
         return None
     # A bare ask ("can you go and check", "go and see") points back as "there" does when the
-    # story's last clause is told by someone (not said to the robot) and says where a thing is now
-    # or was put ("I think she left her bag by the bath", "it is hiding under the desk"), not where
-    # something only happened ("we watched a film on the sofa").
-    told = doc[_clause_verb(heads[-1])]
-    if not points and not (_tells(told) and _says_where(told)):
-        return None  # "if you begin at the cooker and work along": an instruction, no story
+    # story's last clause is told by someone ("I think she left her bag by the bath", "I dropped
+    # an earring near the toilet"), not said to the robot ("if you begin at the cooker and work
+    # along": an instruction, no story).
+    if not points and not _tells(doc[_clause_verb(heads[-1])]):
+        return None
     # The place the last telling clause names first ("it was on the counter with the sink": the
     # counter; the sink, however the parser hangs it, is its landmark).
     # The rest of that clause from there on says which one ("on the desk in there, not the one in
@@ -551,21 +550,6 @@ def _pointer_referent(doc: Doc, ask: set[int], mentions: list[tuple[int, int, st
         if c.pos_ in ("VERB", "AUX") and c.dep_ in _STORY_DEPS and h.i not in {t.i for t in c.subtree}:
             out -= {t.i for t in c.subtree}
     return out or {t.i for t in h.subtree}
-
-
-def _says_where(v: Token) -> bool:
-    """Whether the clause of verb ``v`` says where a thing is or was put: a placing verb ("left",
-    "put"), a clause not told in the past ("it is hiding under the desk", "my keys might be on the
-    counter"), or what the speaker says they believe happened ("I think she knocked it behind the
-    sofa")."""
-    if v.pos_ not in ("VERB", "AUX"):
-        return False
-    past = v.tag_ in _PAST_TAGS or any(c.dep_ in ("aux", "auxpass") and c.tag_ in _PAST_TAGS for c in v.children)
-    # "I think he dropped his car under the table": a past event the speaker now says, in the
-    # present, they believe: where the thing is now.
-    guessed = v.dep_ == "ccomp" and v.head.tag_ in ("VBP", "VBZ") and any(
-        c.dep_ == "nsubj" and c.lower_ in ("i", "we") for c in v.head.children)
-    return _placing_verb(v) or not past or guessed
 
 
 def _clause_verb(t: Token) -> int:
@@ -611,7 +595,10 @@ def _request_clause(doc: Doc, mentions: list[tuple[int, int, str]]) -> set[int] 
             ask = ask | referent
         outside = [t for t in doc if t.i not in ask]
         tells = any(_tells(t) for t in outside if t.pos_ in ("VERB", "AUX"))
-        named = any(m[0] not in ask for m in mentions) or any(attribute_word(t.lower_) for t in outside)
+        # ... a story that names an object, an attribute, or a thing the map does not hold ("there's
+        # a spider behind the telly, go and look": the spider is no goal, the telly is)
+        named = any(m[0] not in ask for m in mentions) or any(attribute_word(t.lower_) for t in outside) \
+            or any(t.pos_ in ("NOUN", "PROPN") for t in outside)
         return ask if tells and named else None
     return None
 
