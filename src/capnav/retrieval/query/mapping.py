@@ -400,6 +400,10 @@ def _split_alternatives(words: list[str]) -> list[list[str]]:
     return [p for p in parts if p]
 
 
+#: Prepositions of the place where a verb's action happens ("lie down on", "sit at", "relax in").
+_VERB_PLACE_PREPS = ("on", "at", "in", "onto", "into")
+
+
 def _negations(q: ParsedQuery, head: str) -> str:
     """Fill ``q.negations`` with what the target must not be, as short phrases a parse of their own
     reads ("white", "in the bedroom"); returns ``head`` without them. The negated phrase's category
@@ -407,6 +411,12 @@ def _negations(q: ParsedQuery, head: str) -> str:
     out = head
     for m in list(_NEGATION.finditer(head))[::-1]:
         words = m.group("neg").split()
+        if words and words[0] in _VERB_PLACE_PREPS and _find_category(out[: m.start()].split())[0] is None \
+                and _find_category(words[1:])[0] is not None:
+            # "somewhere to lie down, but not on the orange bed": with no object named before it,
+            # "on" is the place of the activity's verb (as "sit on the armchair" is the goal), so
+            # the bed is what is excluded, not what stands on it.
+            words = words[1:]
         if negated_relation(" ".join(words)) is not None:
             # "the lamp that's not beside the bed": the bed is the excluded relation's landmark,
             # not the target; the phrase is excluded whole (``constraints.negation``).
@@ -418,9 +428,15 @@ def _negations(q: ParsedQuery, head: str) -> str:
         # The wanted one may be said after the negation ("not the desk, the cabinet by the wall",
         # "not either of the desks but the cabinet"): another category there names the target too.
         after = _find_category(_after_negation(out[m.end():]).split())[0]
-        if cat is not None and ((before is not None and before != cat) or (after is not None and after != cat)):
+        # A request by purpose names no category of its own ("somewhere to sit, not the sofa"):
+        # the negated one is excluded from the furniture that serves it, not made the target.
+        by_use = before is None and after is None and find_activity(out[: m.start()]) is not None
+        if cat is not None and ((before is not None and before != cat) or (after is not None and after != cat)
+                                or by_use):
             # "the sink, not the bathtub": another kind than the one asked for is excluded whole.
             out = out[: m.start()] + " " + out[m.end():]
+            if by_use and span is not None:
+                words = words[: span[1]]  # "..., but not on the sofa please": the sofa
             q.negations.append(" ".join(w for w in words if w not in _DETERMINERS))
             continue
         if cat is not None and span is not None:
