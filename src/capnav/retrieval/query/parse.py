@@ -442,6 +442,17 @@ def _tells(clause: Token) -> bool:
     return any(c.dep_ in ("nsubj", "nsubjpass", "expl") and c.lower_ != "you" for c in clause.children)
 
 
+def _story_rooms(rooms: list[tuple[int, int, str]], ask: set[int]) -> list[tuple[int, int, str]]:
+    """The rooms a story keeps for its ask: the ask's own, else the last room the story names
+    before the ask, where it ended up ("I was in the kitchen making toast and then wandered off
+    to the office, the post is on the desk I think": the office, not the kitchen)."""
+    own = [r for r in rooms if r[0] in ask]
+    if own:
+        return own
+    before = [r for r in rooms if r[0] < min(ask)]
+    return before[-1:]
+
+
 def _room_phrases(doc: Doc, rooms: list[tuple[int, int, str]]) -> set[int]:
     """The tokens of each room's phrase ("in the bedroom"): what a story keeps for its ask."""
     out: set[int] = set()
@@ -659,11 +670,11 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
         # Every object named is a landmark of something unnamed ("what is next to the fridge"):
         # the whole goal (its ask, after a story) goes to the mapping.
         if ask is not None:
-            g.core = _words(doc, set(ask) | _room_phrases(doc, rooms), rooms, refs)
+            g.core = _words(doc, set(ask) | _room_phrases(doc, _story_rooms(rooms, ask)), rooms, refs)
         return g
     head = _span_head(doc, s, e)
     g.head = doc[s:e].text
-    keep = {t.i for t in doc} if ask is None else set(ask) | _room_phrases(doc, rooms)
+    keep = {t.i for t in doc} if ask is None else set(ask) | _room_phrases(doc, _story_rooms(rooms, ask))
     named = {i for m in mentions for i in range(m[0], m[1])} | room_tokens
     # Up the tree from the head: a phrase or clause hanging on the way that names no object or
     # room but carries an attribute word ("every blue moon", "when I feel blue", "nip round")
