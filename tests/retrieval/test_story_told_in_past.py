@@ -81,10 +81,10 @@ def test_asked_goals_stay_several(text: str) -> None:
 
 
 @pytest.mark.parametrize(("text", "left_out", "kept"), [
-    ("we were having breakfast in the kitchen and then I went up to the bedroom, I think I left my watch on "
-     "the nightstand, go and get it", "kitchen", "nightstand"),
-    ("I was reading in the living room and after that I went into the study, my book is on the desk I reckon, "
-     "fetch it for me", "living room", "desk"),
+    ("we were having breakfast in the kitchen by the fridge and then I went up to the bedroom, I think I left "
+     "my watch on the nightstand, go and get it", "kitchen", "nightstand"),
+    ("I was reading on the sofa in the living room and after that I went into the study, my book is on the "
+     "desk I reckon, fetch it for me", "living room", "desk"),
 ])
 def test_a_story_keeps_the_last_room_it_reached(text: str, left_out: str, kept: str) -> None:
     from capnav.retrieval.query.parse import analyse

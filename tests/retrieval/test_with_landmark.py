@@ -53,3 +53,12 @@ def test_the_words_of_the_landmark_are_not_the_targets(text: str, anchor: str, c
 def test_a_piece_of_the_target_stays_a_piece(text: str, part: str) -> None:
     q = parse_instruction(text)
     assert q.anchor_category is None and part in q.part_materials, q
+
+
+@pytest.mark.parametrize("text", [
+    "the bookcase with the tall shelves",  # its own shelves (a form of its own category)
+    "the cupboard with the stone top",  # "stone" is no stove, though one letter from it
+])
+def test_no_landmark_from_its_own_category_or_a_misspelling(text: str) -> None:
+    q = parse_instruction(text)
+    assert q.anchor_category is None and q.relation is None, q

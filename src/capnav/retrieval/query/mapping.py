@@ -525,11 +525,19 @@ def _with_landmark(q: ParsedQuery, head: str) -> str:
     if m is None or m.start() == 0:
         return head
     before = head[:m.start()].split()
+    points_back = _BACK_TO_TARGET.search(m.group(1)) is not None
     anchor = _BACK_TO_TARGET.sub("", m.group(1)).strip()
     words = anchor.split()
     target, _, _ = _find_category(before)
-    cat, span, _ = _find_category(words)
-    if target is None or cat is None or span is None or _own_piece(words[span[1] - 1], before):
+    cat, span, fuzzy = _find_category(words)
+    # Not a word read as a category only by a typo's spelling ("stone" for a stove), nor the
+    # target's own category ("the bookshelf with the sparse shelves": its own shelves).
+    if target is None or cat is None or span is None or fuzzy or cat == target \
+            or _own_piece(words[span[1] - 1], before):
+        return head
+    # Only when the phrase says it is another object: words of its own ("the blue chair") or a
+    # pointer back at the target ("... at it"); "the dresser with the mirror" may be one piece.
+    if not points_back and not any(attribute_word(w) for w in words[: span[0]]):
         return head
     q.relation, q.anchor_category, q.anchor_phrase = "next to", cat, anchor
     return head[:m.start()].strip()

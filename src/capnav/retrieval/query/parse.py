@@ -524,7 +524,7 @@ def _asks(v: Token) -> bool:
     if (v.lemma_ or v.lower_).lower() in _REQUEST_VERBS:
         # ... unless it tells what someone did ("after I got out of bed", "then went to get a
         # glass of water"): a past form, or a subject other than the robot.
-        return v.tag_ not in _PAST_TAGS and all(c.lower_ == "you" for c in subj)
+        return v.tag_ not in _PAST_TAGS and (not subj or any(c.lower_ == "you" for c in subj))
     if subj:
         return any(c.lower_ == "you" for c in subj) and v.tag_ == "VB" \
             and any(c.dep_ == "aux" and c.lower_ in _ASK_MODALS for c in v.children)
@@ -547,8 +547,11 @@ def _pointer_referent(doc: Doc, ask: set[int], mentions: list[tuple[int, int, st
     # story's last clause is told by someone ("I think she left her bag by the bath", "I dropped
     # an earring near the toilet"), not said to the robot ("if you begin at the cooker and work
     # along": an instruction, no story).
-    if not points and not _tells(doc[_clause_verb(heads[-1])]):
-        return None
+    if not points and (not _tells(doc[_clause_verb(heads[-1])]) or any(doc[i].lower_ in _GENERIC for i in ask)):
+        return None  # ... nor one that names its own target ("take me to the other one")
+    top = next((doc[i] for i in ask if doc[i].head.i not in ask or doc[i].head.i == i), None)
+    if not points and top is not None and top.dep_ == "conj" and _asks(top.head):
+        return None  # "could you pop over there and take a peek": the ask is the first verb's
     # The place the last telling clause names first ("it was on the counter with the sink": the
     # counter; the sink, however the parser hangs it, is its landmark).
     # The rest of that clause from there on says which one ("on the desk in there, not the one in
@@ -599,17 +602,21 @@ def _request_clause(doc: Doc, mentions: list[tuple[int, int, str]]) -> set[int] 
                 ask -= {t.i for t in c.subtree}
         if not ask:
             continue
+        bare = False
         if not any(m[0] in ask for m in mentions):
             referent = _pointer_referent(doc, ask, mentions)
             if referent is None:
                 continue
+            # A bare ask ("can you go and check") has nothing of its own: the story named the
+            # object it points at, and that is the story's naming.
+            bare = not any(doc[i].lower_ in _POINTERS for i in ask)
             ask = ask | referent
         outside = [t for t in doc if t.i not in ask]
         tells = any(_tells(t) for t in outside if t.pos_ in ("VERB", "AUX"))
-        # ... a story that names an object, an attribute, or a thing the map does not hold ("there's
-        # a spider behind the telly, go and look": the spider is no goal, the telly is)
-        named = any(m[0] not in ask for m in mentions) or any(attribute_word(t.lower_) for t in outside) \
-            or any(t.pos_ in ("NOUN", "PROPN") for t in outside)
+        # ... a story that names an object, an attribute or a room ("I was in the kitchen making
+        # toast, then wandered off to the office, the post is on the desk I think, fetch it")
+        named = bare or any(m[0] not in ask for m in mentions) or any(attribute_word(t.lower_) for t in outside) \
+            or any(r[0] not in ask for r in _room_mentions(doc))
         return ask if tells and named else None
     return None
 
