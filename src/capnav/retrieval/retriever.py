@@ -323,11 +323,11 @@ class Retriever:
         pos = {int(i): k for k, i in enumerate(rk.order)}
         group = {int(i): int(g) for i, g in zip(rk.order, rk.groups, strict=True)}
 
-        def key(i: int) -> tuple[int, int, float, int]:
+        def key(i: int) -> tuple[int, int, int, float, int]:
             a_ = judged.get(i)
             if a_ is None:
-                return (1, group[i], 0.0, pos[i])
-            return (0 if a_.ok else 1, group[i], -a_.value, pos[i])
+                return (1, group[i], 0, 0.0, pos[i])
+            return (0 if a_.ok else 1, group[i], -constraints.shown_count(a_.evidence), -a_.value, pos[i])
 
         return sorted((int(i) for i in rk.order), key=key)
 
@@ -368,6 +368,10 @@ class Retriever:
             return f"ranked after the chosen object {by}" + (f" ({'; '.join(diffs)})" if diffs else "")
         diffs = [f"{k} {a_.terms[k]:.2f} vs {best.terms[k]:.2f}" for k in a_.terms
                  if k in best.terms and k != "similarity" and a_.terms[k] < best.terms[k] - 1e-6]
+        if constraints.shown_count(a_.evidence) < constraints.shown_count(best.evidence):
+            shown = "/".join(constraints.shown_kinds(best.evidence))
+            return (f"the map shows the chosen object's {shown}, not this one's"
+                    + (f" ({'; '.join(diffs)})" if diffs else ""))
         return (f"lower verification score {a_.value:.2f} vs {best.value:.2f}"
                 + (f" ({'; '.join(diffs)})" if diffs else ""))
 

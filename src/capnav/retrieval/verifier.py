@@ -37,7 +37,7 @@ from capnav.language.prompts import Verdict, caption_name, parse_verdict, verifi
 from capnav.language.surface import Surface, grain_agrees, material_conflict, resolved_grain
 from capnav.language.vlm.base import RateLimited, VisionLanguageModel, create_vlm
 from capnav.mapping.objects import MapObject
-from capnav.retrieval.constraints import Evidence, attribute_constraints
+from capnav.retrieval.constraints import Evidence, attribute_constraints, shown_count
 from capnav.retrieval.constraints.name import Name
 from capnav.retrieval.query import ParsedQuery
 
@@ -380,19 +380,22 @@ class OfflineVerifier(Verifier):
         return Assessment(True, float(val), terms, reason, evidence)
 
     def verify(self, query: ParsedQuery, batch: list[Candidate]) -> Verdict:
-        best: tuple[int, float, int, str] | None = None
+        best: tuple[int, int, float, int, str] | None = None
         rejects: list[str] = []
         for i, c in enumerate(batch):
             v = self.assess(query, c, i / max(len(batch), 1))
             if not v.ok:
                 rejects.append(v.reason)
                 continue
-            # The lowest predicate group first; within it the highest value.
-            if best is None or (c.group, -v.value) < (best[0], -best[1]):
-                best = (c.group, v.value, i, v.reason)
+            # The lowest predicate group first; within it the candidates the map shows a stated
+            # material on (``AttributeConstraint.shown``) before those it cannot tell about, then
+            # the highest value.
+            seen = shown_count(v.evidence)
+            if best is None or (c.group, -seen, -v.value) < (best[0], -best[1], -best[2]):
+                best = (c.group, seen, v.value, i, v.reason)
         if best is None:
             return Verdict(None, rejects[0] if rejects else "no candidate")
-        return Verdict(best[2], best[3])
+        return Verdict(best[3], best[4])
 
 
 class VLMVerifier(Verifier):

@@ -50,6 +50,17 @@ def attribute_constraints(q: ParsedQuery) -> list[AttributeConstraint]:
     return [c() for c in ATTRIBUTES if c.applies(q)]
 
 
+def shown_kinds(evidence: list[Evidence]) -> list[str]:
+    """The stated attributes the map shows outright on a candidate (``supported`` evidence of a
+    kind whose support is an observation, ``AttributeConstraint.shown``: a material's grain)."""
+    shown = {c.kind for c in ATTRIBUTES if c.shown}
+    return [e.kind for e in evidence if e.kind in shown and e.status == SUPPORTED]
+
+
+def shown_count(evidence: list[Evidence]) -> int:
+    return len(shown_kinds(evidence))
+
+
 def rank(r: Candidates, q: ParsedQuery, s: NDArray[np.float32], robot_xy: tuple[float, float] | None,
          notes: list[str]) -> tuple[Ranking, RankState]:
     """Apply the ranking constraints, sort, then the ones that read the order (an ordinal)."""
@@ -74,4 +85,5 @@ def rank(r: Candidates, q: ParsedQuery, s: NDArray[np.float32], robot_xy: tuple[
 
 
 __all__ = ["ATTRIBUTES", "CONTRADICTED", "RANKING", "SUPPORTED", "UNOBSERVED", "AttributeConstraint", "Evidence",
-           "RankState", "RankingConstraint", "Status", "attribute_constraints", "rank", "ranking_constraints"]
+           "RankState", "RankingConstraint", "Status", "attribute_constraints", "rank", "ranking_constraints",
+           "shown_count", "shown_kinds"]

@@ -116,6 +116,11 @@ class AttributeConstraint(ABC):
     kind: str
     order: int
     weight_field: str  # the ``OfflineVerifierConfig`` weight of its agreement
+    #: Whether its ``supported`` evidence is the map showing the attribute outright (the grain of a
+    #: spoken material), not a graded fit: such evidence puts a candidate before those of its
+    #: predicate group on which the map cannot tell, ahead of the retrieval order (colour and size
+    #: are graded and weigh in through their agreement; shape, see ``Shape``).
+    shown: bool = False
 
     @staticmethod
     @abstractmethod

@@ -28,6 +28,7 @@ class Material(AttributeConstraint):
     kind = "material"
     order = 50
     weight_field = "w_material"
+    shown = True
 
     @staticmethod
     def applies(q: ParsedQuery) -> bool:

@@ -25,6 +25,10 @@ class Shape(AttributeConstraint):
     kind = "shape"
     order = 40
     weight_field = "w_shape"
+    #: Not ``shown``: an outline word is said only above the footprint's resolution, so a small
+    #: object's outline is unobserved far more often than a large one's, and putting the objects
+    #: that show a shape first would override the size said with it (a small plant's growth word
+    #: goes unseen where the big ones' is seen: a development-set request dropped when it was).
 
     @staticmethod
     def applies(q: ParsedQuery) -> bool:

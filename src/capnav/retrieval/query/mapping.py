@@ -400,6 +400,10 @@ def _split_alternatives(words: list[str]) -> list[list[str]]:
     return [p for p in parts if p]
 
 
+#: Prepositions of the place where a verb's action happens ("lie down on", "sit at", "relax in").
+_VERB_PLACE_PREPS = ("on", "at", "in", "onto", "into")
+
+
 def _negations(q: ParsedQuery, head: str) -> str:
     """Fill ``q.negations`` with what the target must not be, as short phrases a parse of their own
     reads ("white", "in the bedroom"); returns ``head`` without them. The negated phrase's category
@@ -407,6 +411,12 @@ def _negations(q: ParsedQuery, head: str) -> str:
     out = head
     for m in list(_NEGATION.finditer(head))[::-1]:
         words = m.group("neg").split()
+        if words and words[0] in _VERB_PLACE_PREPS and _find_category(out[: m.start()].split())[0] is None \
+                and _find_category(words[1:])[0] is not None:
+            # "somewhere to lie down, but not on the orange bed": with no object named before it,
+            # "on" is the place of the activity's verb (as "sit on the armchair" is the goal), so
+            # the bed is what is excluded, not what stands on it.
+            words = words[1:]
         if negated_relation(" ".join(words)) is not None:
             # "the lamp that's not beside the bed": the bed is the excluded relation's landmark,
             # not the target; the phrase is excluded whole (``constraints.negation``).
@@ -418,9 +428,15 @@ def _negations(q: ParsedQuery, head: str) -> str:
         # The wanted one may be said after the negation ("not the desk, the cabinet by the wall",
         # "not either of the desks but the cabinet"): another category there names the target too.
         after = _find_category(_after_negation(out[m.end():]).split())[0]
-        if cat is not None and ((before is not None and before != cat) or (after is not None and after != cat)):
+        # A request by purpose names no category of its own ("somewhere to sit, not the sofa"):
+        # the negated one is excluded from the furniture that serves it, not made the target.
+        by_use = before is None and after is None and find_activity(out[: m.start()]) is not None
+        if cat is not None and ((before is not None and before != cat) or (after is not None and after != cat)
+                                or by_use):
             # "the sink, not the bathtub": another kind than the one asked for is excluded whole.
             out = out[: m.start()] + " " + out[m.end():]
+            if by_use and span is not None:
+                words = words[: span[1]]  # "..., but not on the sofa please": the sofa
             q.negations.append(" ".join(w for w in words if w not in _DETERMINERS))
             continue
         if cat is not None and span is not None:
@@ -492,6 +508,39 @@ _PREPOSITIONS = _MOTION_NEXT | {"in", "out", "under", "off", "from", "of", "by",
 #: Words that say a part follows: "the dresser with the glass top", "a stool that has a leather seat".
 _HAVING = {"with", "has", "having", "have"}
 _PART_DETERMINERS = {"a", "an", "the", "its", "their", "some", "two", "three", "four"}
+
+
+#: "... at it", "... next to it", "... around them": the pronoun that points back at the target.
+_BACK_TO_TARGET = re.compile(r"\s+(?:at|by|next to|beside|around|round|in front of|near|under|in|on)\s+(?:it|them)\s*$")
+
+
+def _with_landmark(q: ParsedQuery, head: str) -> str:
+    """"the desk with the blue chair at it", "the table that has the green stools round it": a
+    category after "with" / "that has" that is no piece of the target (``_own_piece``: "a chair
+    with a velvet seat" is) is another object beside it, a landmark "next to" the target, and
+    the words said of it (blue, green) are the landmark's, not the target's. Returns ``head``
+    without the phrase."""
+    m = re.search(r"\b(?:with|(?:that|which)\s+(?:has|have)|having)\s+(?:the\s+|a\s+|an\s+|some\s+|its\s+)?(.+)$",
+                  head)
+    if m is None or m.start() == 0:
+        return head
+    before = head[:m.start()].split()
+    points_back = _BACK_TO_TARGET.search(m.group(1)) is not None
+    anchor = _BACK_TO_TARGET.sub("", m.group(1)).strip()
+    words = anchor.split()
+    target, _, _ = _find_category(before)
+    cat, span, fuzzy = _find_category(words)
+    # Not a word read as a category only by a typo's spelling ("stone" for a stove), nor the
+    # target's own category ("the bookshelf with the sparse shelves": its own shelves).
+    if target is None or cat is None or span is None or fuzzy or cat == target \
+            or _own_piece(words[span[1] - 1], before):
+        return head
+    # Only when the phrase says it is another object: words of its own ("the blue chair") or a
+    # pointer back at the target ("... at it"); "the dresser with the mirror" may be one piece.
+    if not points_back and not any(attribute_word(w) for w in words[: span[0]]):
+        return head
+    q.relation, q.anchor_category, q.anchor_phrase = "next to", cat, anchor
+    return head[:m.start()].strip()
 
 
 def _own_piece(part: str, before: list[str]) -> bool:
@@ -762,6 +811,9 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                     q.anchor_phrase = m.group(1)
                     head = head[:m.start()]
                     break
+    # "the desk with the blue chair at it": another object the target has by it, a landmark.
+    if q.anchor_category is None:
+        head = _with_landmark(q, head)
     words = _joined_compounds([w for w in re.split(r"\s+", head.strip()) if w])
     for phrase in sorted(_SUPERLATIVE, key=len, reverse=True):
         if phrase in head and re.search(rf"\b{phrase}\b", head):

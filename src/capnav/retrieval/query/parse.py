@@ -292,6 +292,7 @@ def analyse(text: str, use_parser: bool | None = None) -> list[GoalParse]:
                                     f"({pip_hint('capnav[parse]')})"]
         return [GoalParse(g, g, notes=list(note)) for g in goals]
     name = f"spacy {nlp.meta.get('name', '?')} {nlp.meta.get('version', '?')}"
+    goals = _join_told_pieces(nlp, text, goals)
     out = []
     for g in goals:
         try:
@@ -300,6 +301,54 @@ def analyse(text: str, use_parser: bool | None = None) -> list[GoalParse]:
             out.append(GoalParse(g, g, parser="patterns", notes=[f"the parser could not read {g!r} "
                                                                   f"({type(e).__name__}); read by word patterns"]))
     return out
+
+
+#: Tags of a verb told in the past ("was reading", "ran off", "had been sitting").
+_PAST_TAGS = {"VBD", "VBN"}
+
+
+def _told_in_past(doc: Doc) -> bool:
+    """Whether the piece ``doc`` tells what happened (a clause in the past: "my daughter was
+    doing her homework at the desk", "went to get a glass of water") and nothing in it asks the
+    robot (``_asks``): such a piece is the story before a request, not a goal of its own, even
+    when a sequence word ("and then") runs through the story."""
+    verbs = [t for t in doc if t.pos_ in ("VERB", "AUX")]
+    if not verbs or any(_asks(v) for v in verbs):
+        return False
+    roots = [t for t in doc if t.dep_ == "ROOT"]
+    return all(r.tag_ in _PAST_TAGS or any(c.dep_ in ("aux", "auxpass") and c.tag_ in _PAST_TAGS
+                                           for c in r.children) for r in roots)
+
+
+def _join_told_pieces(nlp: Language, text: str, goals: list[str]) -> list[str]:
+    """The goals with each piece told in the past (``_told_in_past``) joined to the goal after it
+    (the last one to the goal before it), as the text says them: the story stays with the request
+    it leads to, whose parse then reads the ask in its own clause (``_request_clause``)."""
+    if len(goals) < 2:
+        return goals
+    told = [_told_in_past(nlp(g)) for g in goals]
+    if not any(told):
+        return goals
+    spans, pos = [], 0
+    for g in goals:  # each goal's span of the text (a piece that joined another is not one span)
+        k = text.find(g, pos)
+        if k < 0:
+            return goals
+        spans.append((k, k + len(g)))
+        pos = k + len(g)
+    runs: list[list[int]] = []
+    open_run: list[int] = []
+    for i, t in enumerate(told):
+        open_run.append(i)
+        if not t:
+            runs.append(open_run)
+            open_run = []
+    if open_run:
+        if runs:
+            runs[-1] += open_run
+        else:
+            runs.append(open_run)
+    return [text[spans[r[0]][0]:spans[r[-1]][1]] for r in runs]
 
 
 def _mentions(doc: Doc) -> list[tuple[int, int, str]]:
@@ -393,6 +442,17 @@ def _tells(clause: Token) -> bool:
     return any(c.dep_ in ("nsubj", "nsubjpass", "expl") and c.lower_ != "you" for c in clause.children)
 
 
+def _story_rooms(rooms: list[tuple[int, int, str]], ask: set[int]) -> list[tuple[int, int, str]]:
+    """The rooms a story keeps for its ask: the ask's own, else the last room the story names
+    before the ask, where it ended up ("I was in the kitchen making toast and then wandered off
+    to the office, the post is on the desk I think": the office, not the kitchen)."""
+    own = [r for r in rooms if r[0] in ask]
+    if own:
+        return own
+    before = [r for r in rooms if r[0] < min(ask)]
+    return before[-1:]
+
+
 def _room_phrases(doc: Doc, rooms: list[tuple[int, int, str]]) -> set[int]:
     """The tokens of each room's phrase ("in the bedroom"): what a story keeps for its ask."""
     out: set[int] = set()
@@ -460,9 +520,11 @@ def _asks(v: Token) -> bool:
     "you" with a modal, "could you roll over ..."): the structure, not a list, says it is the ask."""
     if v.pos_ != "VERB":
         return False
-    if (v.lemma_ or v.lower_).lower() in _REQUEST_VERBS:
-        return True
     subj = [c for c in v.children if c.dep_ in ("nsubj", "nsubjpass", "expl")]
+    if (v.lemma_ or v.lower_).lower() in _REQUEST_VERBS:
+        # ... unless it tells what someone did ("after I got out of bed", "then went to get a
+        # glass of water"): a past form, or a subject other than the robot.
+        return v.tag_ not in _PAST_TAGS and (not subj or any(c.lower_ == "you" for c in subj))
     if subj:
         return any(c.lower_ == "you" for c in subj) and v.tag_ == "VB" \
             and any(c.dep_ == "aux" and c.lower_ in _ASK_MODALS for c in v.children)
@@ -476,12 +538,20 @@ def _pointer_referent(doc: Doc, ask: set[int], mentions: list[tuple[int, int, st
     have a look at it"): the phrase of the story's last object named before it (a correction,
     "maybe on the sofa, no, on the nightstand", names its place last). None when it points at
     nothing."""
-    if not any(doc[i].lower_ in _POINTERS and doc[i].pos_ in ("ADV", "PRON")
-               and doc[i].dep_ not in ("nsubj", "nsubjpass", "expl") for i in ask):
-        return None
+    points = any(doc[i].lower_ in _POINTERS and doc[i].pos_ in ("ADV", "PRON")
+                 and doc[i].dep_ not in ("nsubj", "nsubjpass", "expl") for i in ask)
     heads = [_span_head(doc, m[0], m[1]) for m in mentions if m[0] not in ask and m[0] < min(ask)]
     if not heads:
         return None
+    # A bare ask ("can you go and check", "go and see") points back as "there" does when the
+    # story's last clause is told by someone ("I think she left her bag by the bath", "I dropped
+    # an earring near the toilet"), not said to the robot ("if you begin at the cooker and work
+    # along": an instruction, no story).
+    if not points and (not _tells(doc[_clause_verb(heads[-1])]) or any(doc[i].lower_ in _GENERIC for i in ask)):
+        return None  # ... nor one that names its own target ("take me to the other one")
+    top = next((doc[i] for i in ask if doc[i].head.i not in ask or doc[i].head.i == i), None)
+    if not points and top is not None and top.dep_ == "conj" and _asks(top.head):
+        return None  # "could you pop over there and take a peek": the ask is the first verb's
     # The place the last telling clause names first ("it was on the counter with the sink": the
     # counter; the sink, however the parser hangs it, is its landmark).
     # The rest of that clause from there on says which one ("on the desk in there, not the one in
@@ -513,9 +583,14 @@ def _request_clause(doc: Doc, mentions: list[tuple[int, int, str]]) -> set[int] 
     of "bring"); an ask that names none but points back at the story ("... it was on the
     nightstand, zip over there") is the object it points at. Only when what lies outside it
     tells a story that names an object or an attribute. None when the whole text is the ask."""
-    for v in reversed(doc):
-        if not _asks(v):
-            continue
+    asking = [v for v in reversed(doc) if _asks(v)]
+    if not asking:
+        # A story that ends without asking, in a clause not told in the past: one that says where
+        # a thing is by pointing back ("..., I sat at the desk, my phone must still be on it") or
+        # names what is wanted ("..., but what I need now is the ottoman"): that clause is the ask.
+        asking = [t for t in reversed(doc) if t.dep_ in ("ROOT", "conj", "parataxis") and t.pos_ in ("VERB", "AUX")
+                  and t.tag_ not in _PAST_TAGS][:1]
+    for v in asking:
         # "pop over there and check": the second of two coordinated asks (the parser may not
         # take the first for a verb) points back together with the first, unless that one tells
         # or names an object ("begin at the cooker and work along": the cooker is no goal).
@@ -527,14 +602,21 @@ def _request_clause(doc: Doc, mentions: list[tuple[int, int, str]]) -> set[int] 
                 ask -= {t.i for t in c.subtree}
         if not ask:
             continue
+        bare = False
         if not any(m[0] in ask for m in mentions):
             referent = _pointer_referent(doc, ask, mentions)
             if referent is None:
                 continue
+            # A bare ask ("can you go and check") has nothing of its own: the story named the
+            # object it points at, and that is the story's naming.
+            bare = not any(doc[i].lower_ in _POINTERS for i in ask)
             ask = ask | referent
         outside = [t for t in doc if t.i not in ask]
         tells = any(_tells(t) for t in outside if t.pos_ in ("VERB", "AUX"))
-        named = any(m[0] not in ask for m in mentions) or any(attribute_word(t.lower_) for t in outside)
+        # ... a story that names an object, an attribute or a room ("I was in the kitchen making
+        # toast, then wandered off to the office, the post is on the desk I think, fetch it")
+        named = bare or any(m[0] not in ask for m in mentions) or any(attribute_word(t.lower_) for t in outside) \
+            or any(r[0] not in ask for r in _room_mentions(doc))
         return ask if tells and named else None
     return None
 
@@ -595,11 +677,11 @@ def _structure(doc: Doc, text: str, parser: str) -> GoalParse:
         # Every object named is a landmark of something unnamed ("what is next to the fridge"):
         # the whole goal (its ask, after a story) goes to the mapping.
         if ask is not None:
-            g.core = _words(doc, set(ask) | _room_phrases(doc, rooms), rooms, refs)
+            g.core = _words(doc, set(ask) | _room_phrases(doc, _story_rooms(rooms, ask)), rooms, refs)
         return g
     head = _span_head(doc, s, e)
     g.head = doc[s:e].text
-    keep = {t.i for t in doc} if ask is None else set(ask) | _room_phrases(doc, rooms)
+    keep = {t.i for t in doc} if ask is None else set(ask) | _room_phrases(doc, _story_rooms(rooms, ask))
     named = {i for m in mentions for i in range(m[0], m[1])} | room_tokens
     # Up the tree from the head: a phrase or clause hanging on the way that names no object or
     # room but carries an attribute word ("every blue moon", "when I feel blue", "nip round")
