@@ -36,6 +36,18 @@ def legged_table(instance: int = 1, x0: float = 1.6, y0: float = -0.5) -> list[B
     return boxes
 
 
+def legged_chair(instance: int = 1, x0: float = 1.9, y0: float = -0.25) -> list[Box]:
+    """A 0.45 x 0.45 m seat at 0.42-0.46 m on four 4 cm legs, a backrest to 0.9 m: category chair (3)."""
+    c = (40, 40, 160)
+    x1, y1 = x0 + 0.45, y0 + 0.45
+    boxes = [Box((x0, y0, 0.42), (x1, y1, 0.46), instance, 3, c),
+             Box((x1 - 0.04, y0, 0.46), (x1, y1, 0.9), instance, 3, c)]
+    for lx, ly in ((x0, y0), (x1 - 0.04, y0), (x0, y1 - 0.04), (x1 - 0.04, y1 - 0.04)):
+        boxes.append(Box((lx, ly, 0.0), (lx + 0.04, ly + 0.04, 0.42), instance, 3, c))
+    return boxes
+
+
+LOW_CABINET = [Box((1.8, -0.4, 0.0), (2.3, 0.4, 0.46), 1, 3, (90, 60, 30))]  # a chair's seat height, solid
 CABINET = [Box((1.6, -0.5, 0.0), (2.6, 0.3, 0.74), 1, 5, (150, 100, 60))]  # a table's top, solid below
 PANE = [Box((2.4, -0.6, 0.0), (2.43, 0.6, 2.1), 1, 3, (180, 200, 210))]  # a glass door read as a chair
 
@@ -87,6 +99,11 @@ def test_a_cabinet_read_as_a_table_is_not_one(embedder) -> None:  # type: ignore
     assert _labels(CABINET, embedder) == []
 
 
+def test_a_chair_only_ever_weak_is_an_object_and_a_low_cabinet_read_as_one_is_not(embedder) -> None:  # type: ignore[no-untyped-def]
+    assert _labels(legged_chair(), embedder) == ["chair"]
+    assert _labels(LOW_CABINET, embedder) == []
+
+
 def test_a_vertical_pane_read_as_a_chair_is_not_one(embedder) -> None:  # type: ignore[no-untyped-def]
     assert _labels(PANE, embedder) == []
 
@@ -106,6 +123,13 @@ def test_explain_says_why() -> None:
     assert explain("table", [small] * 4, cams)["why"] == "footprint"
     assert explain("table", [top] * 4, [cams[0]] * 4)["why"] == "views"
     assert explain("refrigerator", [top] * 4, cams)["why"] == "no prior"
+    assert explain("sofa", [top * np.array([1, 1, 0.6])] * 4, cams)["why"] == "no prior"  # solid to the floor
+    # A low cabinet seen from above: its top holds most points, its front face (x = 1.6) few, yet
+    # that face runs along a whole side.
+    seat = np.column_stack([rng.uniform(1.6, 2.1, 800), rng.uniform(-0.3, 0.2, 800), rng.normal(0.46, 0.01, 800)])
+    front = np.column_stack([np.full(150, 1.6), rng.uniform(-0.3, 0.2, 150), rng.uniform(0.05, 0.44, 150)])
+    r = explain("chair", [np.concatenate([seat, front])] * 4, cams)
+    assert r["why"] == "closed below" and float(r["below"]) < 0.35 and float(r["face"]) > 0.3
 
 
 def test_distinct_views_counts_places_and_directions() -> None:
