@@ -103,6 +103,8 @@ def test_clutter_seen_as_often_as_it_is_weak_stays_out(embedder) -> None:  # typ
 
 
 def test_weak_sightings_alone_need_weak_confident_zero(embedder) -> None:  # type: ignore[no-untyped-def]
+    """This scene's table is a solid block (closed below, a cabinet's shape), so its shape does not
+    confirm it either (``TrackerConfig.weak_shape``; tables on legs: test_weak_shape.py)."""
     table: dict[int, float | dict[str, float]] = {i: 0.2 for i in range(N)}
     assert _labels(_map(Scripted(table), embedder)) == ["chair"]
     assert _labels(_map(Scripted(table), embedder, TrackerConfig(weak_confident=0))) == ["chair", "table"]

@@ -71,7 +71,8 @@ def register(app: typer.Typer) -> None:
             [], "--tracker-option", metavar="KEY=VALUE",
             help="tracker / confirmation setting (capnav.mapping.tracker.TrackerConfig), repeatable, VALUE as "
                  "for --detector-option: h_min=3, weak_h_min=5 (0: no low-score candidates), weak_score=1.0, "
-                 "weak_agreement=0.667, weak_confident=1 (0: low-score sightings alone can confirm)"),
+                 "weak_agreement=0.667, weak_confident=1 (0: low-score sightings alone can confirm), "
+                 "weak_shape=true (false: without a confident sighting, their 3D shape does not confirm them)"),
         encoder: str = typer.Option("label-embedding", help="dense feature encoder backend"),
         embedder: str = typer.Option("minilm", help="text embedder of the label-embedding encoder"),
         max_frames: MaxFrames = None,
@@ -134,6 +135,10 @@ def register(app: typer.Typer) -> None:
             t = cfg.tracker
             con.print(f"{m['weak_confirmed_tracks']} track(s) confirmed from low-score candidates ({t.weak_h_min} "
                       f"sightings, {t.weak_confident} confident, agreeing on the label)", highlight=False)
+        if m.get("shape_confirmed_tracks"):
+            con.print(f"{m['shape_confirmed_tracks']} of them without a confident sighting: their points have "
+                      "the label's shape (a table's top at table height, open below) from 3 camera places",
+                      highlight=False)
         for reason, frames in _grouped(m["frames_skipped"]):
             con.print(f"[yellow]skipped {_frames(frames)}:[/] {reason}", highlight=False)
         for err in m.get("detector_errors", []):

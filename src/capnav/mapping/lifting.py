@@ -50,6 +50,7 @@ class LiftedDetection:
     visibility: float  # 1 - fraction of the outline bordering a nearer surface or the image edge
     truncated: bool
     support: float = 0.0  # m² of surface the mask covers (its 3D support: what its label votes weigh)
+    camera: NDArray[np.float64] | None = None  # (3,) world camera centre of the frame (views of a place)
 
     @property
     def box(self) -> tuple[float, float, float, float]:
@@ -193,5 +194,5 @@ def lift_detection(frame: Frame, det: Detection, index: int, grid: NDArray[np.in
         descriptor=indexed_descriptor(mask, grid, table, (r0, c0), (h, w)),
         points=pts, colors=cols, distance=float(np.linalg.norm(pc)),
         visibility=outline_visibility(mask, depth, image_border=(r0 == 0, c0 == 0, r1 == h, c1 == w)),
-        truncated=det.truncated(w, h), support=support,
+        truncated=det.truncated(w, h), support=support, camera=T[:3, 3].copy(),
     )

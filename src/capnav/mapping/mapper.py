@@ -238,6 +238,7 @@ class Mapper:
             "merged_in_frame": self.frame_merges,
             "relinked_detections": self.memory.relinks,
             "weak_confirmed_tracks": self.memory.weak_confirmed,
+            "shape_confirmed_tracks": self.memory.shape_confirmed,
             "detector": self.detector.id,
             "encoder": self.encoder.id,
             "text_space": self.encoder.text_space,

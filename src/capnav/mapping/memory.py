@@ -30,6 +30,7 @@ from scipy.spatial import ConvexHull, QhullError, cKDTree
 from capnav.core.categories import BY_NAME, confusable
 from capnav.core.errors import InputError
 from capnav.mapping.box_carving import DepthViews, carve
+from capnav.mapping.corroborate import corroborated
 from capnav.mapping.lifting import LiftedDetection
 from capnav.mapping.objects import MapObject, Observation
 from capnav.mapping.support import stands_on
@@ -152,6 +153,7 @@ class ObjectMemory:
         self._next_id = 1
         self.relinks = 0  # detections moved to another object by the recheck
         self.weak_confirmed = 0  # tracks confirmed by the weak-candidate rule (``_confirms``)
+        self.shape_confirmed = 0  # of those, confirmed without a confident sighting by their shape
         self._rng = np.random.default_rng(self.config.seed)
 
     # ---- per frame ----------------------------------------------------------------------
@@ -175,8 +177,9 @@ class ObjectMemory:
             # neighbour (two armchairs side by side), they only help confirm it.
             inherited = self._inherited.get(track.id, 0)
             own = buf[inherited:]
-            self.weak_confirmed += confirmed == "weak"
-            place = self._same_place(own or buf, busy) if confirmed == "weak" else None
+            self.weak_confirmed += confirmed != "strong"
+            self.shape_confirmed += confirmed == "shape"
+            place = self._same_place(own or buf, busy) if confirmed != "strong" else None
             if place is not None:
                 self.objects[place].track_ids.append(track.id)
             oid = place if place is not None else self._link(track, own or buf, busy)
@@ -509,19 +512,30 @@ def _confirms(buf: list[tuple[LiftedDetection, Observation, int]], h_min: int, r
     candidates among them, there are ``rule.weak_h_min`` sightings (``rule.weak_confident`` of them
     confident) whose leading label's summed
     score is at least ``rule.weak_score`` and ``rule.weak_agreement`` of all their label scores;
-    else None (not yet an object)."""
+    "shape" when such sightings lack the confident ones but their points have the leading label's
+    shape from several camera places (``rule.weak_shape``, ``corroborate.corroborated``); else
+    None (not yet an object)."""
     confident = sum(not d.detection.weak for d, _, _ in buf)
     if confident >= h_min:
         return "strong"
-    if rule is None or not rule.weak_h_min or len(buf) < max(rule.weak_h_min, h_min) or confident < rule.weak_confident:
+    if rule is None or not rule.weak_h_min or len(buf) < max(rule.weak_h_min, h_min):
+        return None
+    if confident < rule.weak_confident and not rule.weak_shape:
         return None
     votes: dict[str, float] = {}
     for d, _, _ in buf:
         for label, v in d.detection.label_votes().items():
             votes[label] = votes.get(label, 0.0) + v
-    lead = max(votes.values(), default=0.0)
-    if lead >= rule.weak_score and lead >= rule.weak_agreement * sum(votes.values()):
+    if not votes:
+        return None
+    best = max(votes, key=lambda k: (votes[k], k))
+    lead = votes[best]
+    if lead < rule.weak_score or lead < rule.weak_agreement * sum(votes.values()):
+        return None
+    if confident >= rule.weak_confident:
         return "weak"
+    if corroborated(best, [d.points for d, _, _ in buf], [d.camera for d, _, _ in buf]):
+        return "shape"
     return None
 
 

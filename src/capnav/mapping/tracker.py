@@ -23,9 +23,10 @@ parameters; ours, for indoor mapping at 0.1-0.3 m between frames:
   lookalike label, and confirm an object only by ``weak_h_min`` sightings, ``weak_confident`` of
   them confident, whose leading label sums at least ``weak_score`` and holds ``weak_agreement``
   of their summed label scores, the model's rival readings of the same boxes included
-  (``ObjectMemory.observe``); ``weak_h_min`` is never lowered for a short recording, so a
-  one-frame map keeps no weak candidate. Their label votes count only while a track or an object
-  has no confident one;
+  (``ObjectMemory.observe``); without a confident one, ``weak_shape`` confirms them when their
+  points have the leading label's shape from several camera places (``mapping.corroborate``);
+  ``weak_h_min`` is never lowered for a short recording, so a one-frame map keeps no weak
+  candidate. Their label votes count only while a track or an object has no confident one;
 * ``max_speed = 0.05`` m/frame clips the velocity of eq. 11 (not in the paper): objects are
   static, and the centroid jitter of a moving camera would otherwise be extrapolated during a miss.
 
@@ -70,6 +71,10 @@ class TrackerConfig:
     weak_score: float = 1.0
     weak_agreement: float = 2.0 / 3.0
     weak_confident: int = 1
+    # Without the confident sighting, weak ones confirm a place whose points have the label's shape
+    # (``mapping.corroborate``: a table's top at table height, open below, seen from 3 places): a
+    # real table a COCO detector never scores at its threshold (issue 21), not a glass door.
+    weak_shape: bool = True
 
     def __post_init__(self) -> None:
         if self.d_max <= 0 or self.tau_assoc <= 0:
