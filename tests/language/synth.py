@@ -155,7 +155,7 @@ def described_living_map(folder: Path) -> Path:
     from capnav.language import create_captioner, create_embedder
     from capnav.language.describe import describe_map
 
-    cmap = make_map(living_scene(), grid_with_wall(-1, -1, 9, 7, wall_x=3.8, door=(2.5, 3.5)))
+    cmap = make_map(living_scene(), two_rooms())
     describe_map(cmap, None, create_captioner("offline"), create_embedder("minilm"), progress=False)
     path = folder / "living.capnav"
     CapNav(cmap).save(path)
@@ -218,6 +218,16 @@ def plant_points(center: tuple[float, float], foliage_radius: float, seed: int =
     leaves = disc_points(center, foliage_radius, 0.8, 1500, seed + 1)
     leaves[:, 2] += 0.3
     return np.concatenate([pot, leaves])[rng.permutation(2100)].astype(np.float32)
+
+
+def two_rooms() -> OccupancyGrid:
+    """The living scene's floor: 10 x 8 m, a wall at x = 3.8 with a door at y 2.5-3.5."""
+    return grid_with_wall(-1, -1, 9, 7, wall_x=3.8, door=(2.5, 3.5))
+
+
+def room_of(r: Retriever) -> dict[int, str]:
+    """Map object id -> the room type the retriever's scene gave it."""
+    return {o.id: r.scene.rooms[k] for k, o in enumerate(r.objects)}
 
 
 def grid_with_walls(xmin: float, ymin: float, xmax: float, ymax: float,

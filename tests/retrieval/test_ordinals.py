@@ -15,7 +15,7 @@ import pytest
 from capnav.retrieval import Retriever
 from capnav.retrieval.query import parse as parse_mod
 from capnav.retrieval.query import parse_goals, parse_instruction
-from language.synth import grid_with_walls, make_obj, offline_retriever
+from language.synth import grid_with_walls, make_obj, offline_retriever, room_of
 
 needs_spacy = pytest.mark.skipif(parse_mod.load_parser() is None, reason="spaCy's English pipeline is not installed")
 
@@ -38,7 +38,7 @@ def retriever() -> Retriever:
     ]
     occ = grid_with_walls(-1, -1, 10, 7, [(3.8, (2.5, 3.5)), (5.6, (0.5, 1.5))])
     r = offline_retriever(objs, occ)
-    rooms = {o.id: r.scene.rooms[k] for k, o in enumerate(r.objects)}
+    rooms = room_of(r)
     assert rooms[1] == "kitchen" and rooms[34] == "office" and rooms[21] is None, rooms
     return r
 

@@ -9,7 +9,7 @@ import pytest
 
 from capnav.retrieval import Retriever
 from capnav.retrieval.query import parse as parse_mod
-from language.synth import grid_with_wall, make_obj, offline_retriever
+from language.synth import make_obj, offline_retriever, room_of, two_rooms
 
 needs_spacy = pytest.mark.skipif(parse_mod.load_parser() is None, reason="spaCy's English pipeline is not installed")
 
@@ -26,8 +26,8 @@ def retriever() -> Retriever:
         make_obj(7, "chair", (5.6, 0.6), (0.5, 0.5, 0.9), (200, 200, 200)),  # south, farther
         make_obj(8, "wardrobe", (8.0, 6.2), (1.2, 0.6, 2.0), (230, 230, 230)),
     ]
-    r = offline_retriever(objs, grid_with_wall(-1, -1, 9, 7, wall_x=3.8, door=(2.5, 3.5)))
-    rooms = {o.id: r.scene.rooms[k] for k, o in enumerate(r.objects)}
+    r = offline_retriever(objs, two_rooms())
+    rooms = room_of(r)
     assert rooms[4] == "bedroom" and rooms[1] == "living room", rooms  # the scene types its rooms
     return r
 

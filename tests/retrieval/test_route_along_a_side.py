@@ -11,7 +11,7 @@ import pytest
 from capnav.retrieval import Retriever
 from capnav.retrieval.query import parse as parse_mod
 from capnav.retrieval.query import parse_instruction
-from language.synth import grid_with_wall, make_obj, offline_retriever
+from language.synth import make_obj, offline_retriever, room_of, two_rooms
 
 needs_spacy = pytest.mark.skipif(parse_mod.load_parser() is None, reason="spaCy's English pipeline is not installed")
 
@@ -33,8 +33,8 @@ def retriever() -> Retriever:
         make_obj(8, "stove", (5.0, 0.5), (0.7, 0.6, 0.9), (40, 40, 40)),
         make_obj(9, "washing machine", (6.6, 0.5), (0.6, 0.6, 0.9), (235, 235, 235)),
     ]
-    r = offline_retriever(objs, grid_with_wall(-1, -1, 9, 7, wall_x=3.8, door=(2.5, 3.5)))
-    rooms = {o.id: r.scene.rooms[k] for k, o in enumerate(r.objects)}
+    r = offline_retriever(objs, two_rooms())
+    rooms = room_of(r)
     assert rooms[6] == "kitchen" and rooms[1] == "living room", rooms  # the scene types its rooms
     return r
 

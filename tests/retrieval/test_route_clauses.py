@@ -14,7 +14,7 @@ import pytest
 
 from capnav.retrieval import Retriever
 from capnav.retrieval.query import parse as parse_mod
-from language.synth import grid_with_wall, make_obj, offline_retriever
+from language.synth import grid_with_wall, make_obj, offline_retriever, room_of
 
 needs_spacy = pytest.mark.skipif(parse_mod.load_parser() is None, reason="spaCy's English pipeline is not installed")
 
@@ -36,7 +36,7 @@ def retriever() -> Retriever:
         make_obj(WASHER, "washing machine", (1.6, 0.5), (0.6, 0.6, 0.85), (240, 240, 240)),
     ]
     r = offline_retriever(objs, grid_with_wall(-1, -1, 9, 7, wall_x=4.0, door=(2.5, 3.5)))
-    rooms = {o.id: r.scene.rooms[k] for k, o in enumerate(r.objects)}
+    rooms = room_of(r)
     assert rooms[5] == "living room" and rooms[1] == "kitchen", rooms  # the scene types its rooms
     return r
 

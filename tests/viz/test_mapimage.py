@@ -8,11 +8,11 @@ import numpy as np
 from PIL import Image
 
 from capnav.viz.mapimage import map_picture
-from language.synth import grid_with_wall, living_scene, make_map
+from language.synth import living_scene, make_map, two_rooms
 
 
 def test_boxes_land_where_to_pixel_says() -> None:
-    cmap = make_map(living_scene(), grid_with_wall(-1, -1, 9, 7, wall_x=3.8, door=(2.5, 3.5)))
+    cmap = make_map(living_scene(), two_rooms())
     pic = map_picture(cmap, labels=False)
     img = np.asarray(Image.open(io.BytesIO(pic.png)).convert("RGB"))
     assert img.shape == (pic.height, pic.width, 3) and pic.scale >= 1

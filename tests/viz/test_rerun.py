@@ -18,7 +18,7 @@ from capnav.language import create_captioner, create_embedder, describe_map
 from capnav.mapping.cmap import CameraTrajectory
 from capnav.mapping.voxel_map import VoxelMap
 from capnav.viz.rerun_log import camera_path, category_rgb, eye_pose, write_rrd
-from language.synth import grid_with_wall, living_scene, make_map
+from language.synth import living_scene, make_map, two_rooms
 
 rr = pytest.importorskip("rerun")
 
@@ -43,7 +43,7 @@ def read_back(path: Path, blueprint: bool = False) -> dict[str, dict[str, list]]
 
 @pytest.fixture(scope="module")
 def captioned(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    cmap = make_map(living_scene(), grid_with_wall(-1, -1, 9, 7, wall_x=3.8, door=(2.5, 3.5)))
+    cmap = make_map(living_scene(), two_rooms())
     describe_map(cmap, None, create_captioner("offline"), create_embedder("minilm"), progress=False)
     vox = VoxelMap(0.05, (0.0, 0.0, -0.025), 1)
     rng = np.random.default_rng(0)
