@@ -25,6 +25,7 @@ from __future__ import annotations
 import base64
 import hashlib
 import re
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -343,10 +344,19 @@ class GlossIndex:
     activity's template, so an activity is compared with what a piece of furniture is made for,
     not only with everything its definitions mention."""
 
+    @property
+    def embedder(self) -> TextEmbedder:
+        e = self._embedder()
+        if e is None:
+            raise RuntimeError("the embedder of this gloss index was collected")
+        return e
+
     def __init__(self, embedder: TextEmbedder, lexicon: Lexicon | None = None, max_glosses: int = 6,
                  stored: dict[str, Any] | None = None) -> None:
         lex = lexicon or load_lexicon()
-        self.embedder = embedder
+        # Held weakly: the process-wide table of indexes (``gloss_index``) must not keep every
+        # embedder ever used alive (a test session or a server opening maps grew ~130 MB each).
+        self._embedder = weakref.ref(embedder)
         self.cats: list[str] = []
         texts: list[str] = []
         stated: list[tuple[str, str]] = []
@@ -440,27 +450,23 @@ def _decode(stored: dict[str, Any], digest: str, shape: tuple[int, int]) -> NDAr
         return None
 
 
-_INDEXES: dict[str, GlossIndex] = {}
-_STORED: dict[str, dict[str, Any]] = {}
-
-
-def _key(embedder: TextEmbedder) -> str:
-    return f"{embedder.model_id}@{id(embedder)}"
+#: One index per live embedder; an entry goes when its embedder is collected.
+_INDEXES: weakref.WeakKeyDictionary[TextEmbedder, GlossIndex] = weakref.WeakKeyDictionary()
+_STORED: weakref.WeakKeyDictionary[TextEmbedder, dict[str, Any]] = weakref.WeakKeyDictionary()
 
 
 def use_stored_glosses(embedder: TextEmbedder, stored: dict[str, Any] | None) -> None:
     """Offer a map's stored gloss embeddings (``caches["glosses"]``) to ``embedder``'s index, built
     on the first request by purpose; ignored if the index exists or they do not match."""
-    if stored and _key(embedder) not in _INDEXES:
-        _STORED[_key(embedder)] = stored
+    if stored and embedder not in _INDEXES:
+        _STORED[embedder] = stored
 
 
 def gloss_index(embedder: TextEmbedder) -> GlossIndex:
-    """One gloss index per embedding model and process."""
-    key = _key(embedder)
-    if key not in _INDEXES:
-        _INDEXES[key] = GlossIndex(embedder, stored=_STORED.pop(key, None))
-    return _INDEXES[key]
+    """One gloss index per embedder, for as long as it lives."""
+    if embedder not in _INDEXES:
+        _INDEXES[embedder] = GlossIndex(embedder, stored=_STORED.pop(embedder, None))
+    return _INDEXES[embedder]
 
 
 def match_purpose(activity: str, embedder: TextEmbedder, config: PurposeConfig | None = None,
