@@ -50,6 +50,7 @@ class QueryResult:
             "score": round(self.score, 6), "predicate": self.predicate, "mode": self.mode,
             "distance_m": None if self.distance_m is None else round(self.distance_m, 4),
             "reason": self.reason,
+            "unmet": self.unmet,
             "terms": self.terms,
             "runners_up": self.runners_up(),
             "timings": {k: round(v, 6) for k, v in self.timings.items()},

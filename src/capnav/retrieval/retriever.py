@@ -230,6 +230,9 @@ class Retriever:
             dist = float(d[chosen_i])
         reason = self._explain(q, chosen_i, s, rk, notes, verdict_reason, dist, verifier, runners, judged,
                                dist_kind)
+        unmet = rk.unmet.get(chosen_i) if chosen_i is not None else None
+        if unmet is not None:  # the best there is, not what was asked: said, so a user can judge it
+            reason += f" It does not meet the request's relation: {unmet}."
         return QueryResult(q.text, self.objects[chosen_i] if chosen_i is not None else None, chosen_i is not None,
                            float(s[chosen_i]) if chosen_i is not None else 0.0,
                            [(self.objects[i], sc) for i, sc, _, _ in runners], predicate, reason, timings,
@@ -237,8 +240,7 @@ class Retriever:
                            [{"terms": t, "why": w, "similarity": float(s[i]),
                              "verifier": judged[i].value if i in judged else None} for i, _, t, w in runners],
                            judged[chosen_i].terms if chosen_i in judged else {},
-                           judged[chosen_i].value if chosen_i in judged else None,
-                           rk.unmet.get(chosen_i) if chosen_i is not None else None)
+                           judged[chosen_i].value if chosen_i in judged else None, unmet)
 
     def _about_time(self, instruction: str, robot_xy: tuple[float, float] | None
                     ) -> QueryResult | ParsedQuery | None:
