@@ -110,4 +110,9 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from capnav.core.errors import CapNavError
+
+    try:
+        main()
+    except CapNavError as e:  # a missing weights folder, a recording that cannot be read: said, no traceback
+        sys.exit(f"eval_update_identity.py: {e}")

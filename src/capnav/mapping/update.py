@@ -40,7 +40,7 @@ from capnav.core.progress import track
 from capnav.io.dataset import DatasetReader
 from capnav.mapping.cmap import CameraTrajectory, CapNavMap
 from capnav.mapping.mapper import Mapper, MapperConfig
-from capnav.mapping.memory import labels_compatible
+from capnav.mapping.memory import footprint, labels_compatible
 from capnav.mapping.objects import MapObject
 from capnav.mapping.occupancy import occupancy_from_voxels
 from capnav.mapping.register import RegisterConfig, Registration, RegistrationError, accept, check_fit, depth_cloud
@@ -326,8 +326,6 @@ def _shed(o: MapObject, vanished: NDArray[np.int64], cfg: UpdateConfig, percenti
     if (~up & keep).any():
         d, _ = cKDTree(p[up, :2]).query(p[~up & keep, :2], distance_upper_bound=cfg.shed_floor_radius)
         keep[np.flatnonzero(~up & keep)[~np.isfinite(d)]] = False
-    from capnav.mapping.memory import footprint
-
     c = copy.copy(o)
     c.points, c.colors = o.points[keep].copy(), o.colors[keep].copy()
     q = np.asarray(c.points, np.float64)
