@@ -483,15 +483,7 @@ class ObjectMemory:
         return out
 
     def _to_map_object(self, obj: _ObjectState, new_id: int) -> MapObject:
-        p = obj.points.astype(np.float64)
-        q = self.config.extent_percentile
-        lo = np.percentile(p, q, axis=0)
-        hi = np.percentile(p, 100.0 - q, axis=0)
-        # The footprint is the hull of the points inside the robust extent: a few stray points
-        # (mask edges on the floor or a neighbour) would otherwise stretch the hull, and goals
-        # picked at reach distance from it would end up out of reach of the real object.
-        inside = np.all((p[:, :2] >= lo[:2]) & (p[:, :2] <= hi[:2]), axis=1)
-        fp = footprint(p[inside, :2] if inside.sum() >= 3 else p[:, :2])
+        lo, hi, fp = object_box(obj.points, self.config.extent_percentile)
         label = obj.label
         cat = BY_NAME.get(label)
         mo = MapObject(
@@ -537,6 +529,18 @@ def _confirms(buf: list[tuple[LiftedDetection, Observation, int]], h_min: int, r
     if corroborated(best, [d.points for d, _, _ in buf], [d.camera for d, _, _ in buf]):
         return "shape"
     return None
+
+
+def object_box(points: NDArray[np.floating], percentile: float
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """An object's robust box (``percentile`` .. 100 - ``percentile`` of its points per axis) and
+    footprint. The footprint is the hull of the points inside that box: a few stray points (mask
+    edges on the floor or a neighbour) would otherwise stretch the hull, and goals picked at reach
+    distance from it would end up out of reach of the real object."""
+    p = np.asarray(points, dtype=np.float64)
+    lo, hi = np.percentile(p, percentile, axis=0), np.percentile(p, 100.0 - percentile, axis=0)
+    inside = np.all((p[:, :2] >= lo[:2]) & (p[:, :2] <= hi[:2]), axis=1)
+    return lo, hi, footprint(p[inside, :2] if inside.sum() >= 3 else p[:, :2])
 
 
 def footprint(xy: NDArray[np.float64]) -> NDArray[np.float64]:

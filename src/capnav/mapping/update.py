@@ -40,7 +40,7 @@ from capnav.core.progress import track
 from capnav.io.dataset import DatasetReader
 from capnav.mapping.cmap import CameraTrajectory, CapNavMap
 from capnav.mapping.mapper import Mapper, MapperConfig
-from capnav.mapping.memory import footprint, labels_compatible
+from capnav.mapping.memory import labels_compatible, object_box
 from capnav.mapping.objects import MapObject
 from capnav.mapping.occupancy import occupancy_from_voxels
 from capnav.mapping.register import RegisterConfig, Registration, RegistrationError, accept, check_fit, depth_cloud
@@ -288,8 +288,13 @@ class _Evidence:
         """Indices into object ``q``'s points whose space was seen empty, by the rule that retires
         a whole object (``min_empty_frames``, twice as often as seen)."""
         sel = self.owner == q
-        thr, seen = self.point_through[sel], self.point_seen[sel]
-        return self.source[sel][(thr >= cfg.min_empty_frames) & (thr >= 2 * seen)]
+        return self.source[sel][_seen_empty(self.point_through[sel], self.point_seen[sel], cfg)]
+
+
+def _seen_empty(empty: NDArray[np.int64], present: NDArray[np.int64], cfg: UpdateConfig) -> NDArray[np.bool_]:
+    """Seen empty in ``min_empty_frames`` frames and at least twice as often as present: the rule
+    that retires an object, and sheds a point of one that stays."""
+    return (empty >= cfg.min_empty_frames) & (empty >= 2 * present)
 
 
 def _object_evidence(objects: list[MapObject], cfg: UpdateConfig) -> _Evidence:
@@ -326,15 +331,12 @@ def _shed(o: MapObject, vanished: NDArray[np.int64], cfg: UpdateConfig, percenti
     if (~up & keep).any():
         d, _ = cKDTree(p[up, :2]).query(p[~up & keep, :2], distance_upper_bound=cfg.shed_floor_radius)
         keep[np.flatnonzero(~up & keep)[~np.isfinite(d)]] = False
-    c = copy.copy(o)
-    c.points, c.colors = o.points[keep].copy(), o.colors[keep].copy()
-    q = np.asarray(c.points, np.float64)
-    lo, hi = np.percentile(q, percentile, axis=0), np.percentile(q, 100.0 - percentile, axis=0)
-    inside = np.all((q[:, :2] >= lo[:2]) & (q[:, :2] <= hi[:2]), axis=1)
+    lo, hi, fp = object_box(o.points[keep], percentile)
     if not ((o.extent_max - o.extent_min)[:2] - (hi - lo)[:2] >= cfg.shed_side).any():
         return None
-    c.extent_min, c.extent_max, c.position = lo, hi, (lo + hi) / 2.0
-    c.footprint = footprint(q[inside, :2] if inside.sum() >= 3 else q[:, :2])
+    c = copy.copy(o)
+    c.points, c.colors = o.points[keep].copy(), o.colors[keep].copy()
+    c.extent_min, c.extent_max, c.position, c.footprint = lo, hi, (lo + hi) / 2.0, fp
     return c
 
 
@@ -554,7 +556,7 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
     new_objs = [o for o in sub.objects if o.hits >= cfg.min_hits]
 
     # -- identity: one assignment of the new sightings to the old objects (``_assign``) --
-    gone = (ev.empty >= cfg.min_empty_frames) & (ev.empty >= 2 * ev.present)
+    gone = _seen_empty(ev.empty, ev.present, cfg)
     seen_again = ev.present > 0
     claimed, moved, displaced = _assign(new_objs, old, gone, cfg)
     for q in set(claimed.values()):
