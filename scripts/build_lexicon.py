@@ -236,6 +236,9 @@ def build(wordnet: Path) -> dict[str, Any]:
         out["room_glosses"] = _room_glosses(wn)
         out["gloss_adjectives"] = _gloss_adjectives(wn, out)
         out["furniture_senses"] = _furniture_senses(wn, out["forms"])
+        out["plant_names"] = _plant_names(wn, out)
+        names = set(out["plant_names"])
+        out["other"] = [f for f in out["other"] if f not in names]  # "rubber plant" is one
         out["forms"] = dict(sorted(out["forms"].items()))
         return out
 
@@ -1097,6 +1100,51 @@ def _gloss_adjectives(wn: Any, lex: dict[str, Any]) -> dict[str, list[str]]:
         if cats and len(cats) <= 2:  # a word many definitions say ("small") picks nothing out
             out[lemma] = cats
     return out
+
+
+def _plant_names(wn: Any, out: dict[str, Any]) -> list[str]:
+    """Words for a kind of plant ("ficus", "monstera", "rubber plant"), read as the plant category
+    only where a request names no category otherwise (``tokens.plant_name``): lemmas whose first
+    noun sense is a vascular plant, or a genus of them (WordNet has "Ficus" only as a genus), and
+    that say nothing else a request may mean. Not in ``forms``, where their thousands of names
+    would draw typo corrections and compound checks: only ``ROOTS``' houseplants are there. Left
+    out: words that are also a colour ("olive", "lavender"), a material ("oak", "bamboo", "beech":
+    woods named by their trees), a category, detector class or room word, or (one word) a verb or
+    adjective too ("rose", "palm")."""
+    vascular = wn.synset("vascular_plant.n.01")
+    roots = {n for names in MATERIAL_ROOTS.values() for n in names}
+    taken = (set(out["forms"]) | set(out["labels"]) | set(out["materials"]) | set(out["material_nouns"])
+             | set(LEXICON) | set(ALIASES) | ROOM_WORDS)
+
+    def a_plant(s: Any) -> bool:
+        if s.lexname() != "noun.plant":
+            return False
+        up = s.closure(lambda x: x.hypernyms())
+        return vascular in up or any(vascular in m.closure(lambda x: x.hypernyms()) for m in s.member_meronyms())
+
+    def a_material(lemma: str) -> bool:
+        return any(k.lexname() == "noun.substance" or any(h.name() in roots for h in k.closure(lambda x: x.hypernyms()))
+                   for k in wn.synsets(lemma, "n"))
+
+    found: set[str] = set()
+    for syn in wn.all_synsets("n"):
+        if syn.lexname() != "noun.plant":
+            continue
+        for lem in syn.lemmas():
+            lemma = lem.name()
+            word = _form(lemma)
+            single = " " not in word
+            if lemma != lemma.lower() and not (single and lemma.istitle() and syn.member_meronyms()):
+                continue  # a capitalised name is taken only as a genus said in lower case ("ficus")
+            if word in taken or len(word.split()) > 3 or not all(ch.isalpha() or ch in " -" for ch in word):
+                continue
+            senses = wn.synsets(word.replace(" ", "_"), "n")
+            if not senses or senses[0] != syn or not a_plant(syn) or a_material(word.replace(" ", "_")):
+                continue
+            if single and any(wn.synsets(word, pos) for pos in ("v", "a", "s", "r")):
+                continue
+            found.add(word)
+    return sorted(found)
 
 
 def _furniture_senses(wn: Any, forms: dict[str, str]) -> dict[str, dict[str, Any]]:

@@ -91,6 +91,9 @@ class Lexicon:
     #: a word whose first sense is something else but which WordNet also has as one category's
     #: furniture ("press": the wardrobe's "clothes press") -> {"category", "synset", "alternatives"}
     furniture_senses: dict[str, dict[str, Any]] = field(default_factory=dict)
+    #: words for a kind of plant ("ficus", "rubber plant"): the plant category where a request
+    #: names no category otherwise (WordNet's vascular plants; not in ``forms``)
+    plant_names: frozenset[str] = frozenset()
     load_seconds: float = 0.0
 
     def category_alternatives(self, category: str, form: str | None = None) -> dict[str, float]:
@@ -139,7 +142,8 @@ def load_lexicon() -> Lexicon:
                   attributes={k: (v[0], v[1], v[2]) for k, v in raw.get("attributes", {}).items()},
                   room_glosses={k: tuple(v) for k, v in raw.get("room_glosses", {}).items()},
                   gloss_adjectives={k: tuple(v) for k, v in raw.get("gloss_adjectives", {}).items()},
-                  furniture_senses=dict(raw.get("furniture_senses", {})))
+                  furniture_senses=dict(raw.get("furniture_senses", {})),
+                  plant_names=frozenset(raw.get("plant_names", [])))
     object.__setattr__(lex, "load_seconds", time.perf_counter() - t0)
     return lex
 

@@ -283,7 +283,8 @@ def _find_category(words: list[str]) -> tuple[str | None, tuple[int, int] | None
         label = _find_label(words[span[1]:], 1)
         label = None if label is None else (label[0], (span[1] + label[1][0], span[1] + label[1][1]), False)
     if label is None and cat is None:
-        return furniture_sense(words)
+        found = furniture_sense(words)
+        return found if found[0] is not None else plant_name(words)
     return label if label is not None else (cat, span, fuzzy)
 
 
@@ -303,6 +304,20 @@ def furniture_sense(words: list[str]) -> tuple[str | None, tuple[int, int] | Non
         if k + 1 < len(words) and words[k + 1] in ("of", "to", "up", "down", "on", "off"):
             continue
         return str(_LEX.furniture_senses[base]["category"]), (k, k + 1), False
+    return None, None, False
+
+
+def plant_name(words: list[str]) -> tuple[str | None, tuple[int, int] | None, bool]:
+    """A kind of plant ("the ficus", "the rubber plant", "the yucca by the door") in words that
+    name no category otherwise: the plant category (``Lexicon.plant_names``, from WordNet's
+    vascular plants); the longest name first, a plural read as its singular."""
+    for n in (3, 2, 1):
+        for k in range(len(words) - n + 1):
+            gram = words[k:k + n]
+            last = gram[-1]
+            for tail in (last, last[:-1] if last.endswith("s") else None, last[:-2] if last.endswith("es") else None):
+                if tail and " ".join([*gram[:-1], tail]) in _LEX.plant_names:
+                    return "plant", (k, k + n), False
     return None, None, False
 
 
