@@ -139,6 +139,8 @@ def register(app: typer.Typer) -> None:
             con.print(f"{m['shape_confirmed_tracks']} of them without a confident sighting: their points have "
                       "the label's shape (a table's top at table height, open below) from 3 camera places",
                       highlight=False)
+        for why in m.get("relabelled_by_size", []):
+            con.print(f"label from the size: {why}", highlight=False)
         for reason, frames in _grouped(m["frames_skipped"]):
             con.print(f"[yellow]skipped {_frames(frames)}:[/] {reason}", highlight=False)
         for err in m.get("detector_errors", []):

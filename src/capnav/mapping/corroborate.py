@@ -125,7 +125,7 @@ def _face_length(pts: NDArray[np.float64], cfg: CorroborationConfig) -> float:
     return best
 
 
-def _sides(xy: NDArray[np.float64]) -> tuple[float, float]:
+def sides(xy: NDArray[np.float64]) -> tuple[float, float]:
     """Short and long side (5-95 percentile) of the points along their principal axes."""
     c = xy - xy.mean(axis=0)
     _, vecs = np.linalg.eigh(np.cov(c.T))
@@ -171,7 +171,7 @@ def explain(label: str, points: Sequence[NDArray[np.floating]], cameras: Sequenc
     if zp is None:
         return {"ok": 0.0, "why": "no surface"}
     top = allp[np.abs(allp[:, 2] - zp) <= cfg.tol]
-    short, long = _sides(top[:, :2])
+    short, long = sides(top[:, :2])
     out: dict[str, float | str] = {"z": zp, "short": short, "long": long,
                                    "plane": float(len(top) / len(allp))}
     if short < prior.short_lo or long > prior.long_hi:

@@ -239,6 +239,7 @@ class Mapper:
             "relinked_detections": self.memory.relinks,
             "weak_confirmed_tracks": self.memory.weak_confirmed,
             "shape_confirmed_tracks": self.memory.shape_confirmed,
+            "relabelled_by_size": list(self.memory.relabelled),
             "detector": self.detector.id,
             "encoder": self.encoder.id,
             "text_space": self.encoder.text_space,

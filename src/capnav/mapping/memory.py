@@ -31,6 +31,7 @@ from capnav.core.categories import BY_NAME, confusable
 from capnav.core.errors import InputError
 from capnav.mapping.box_carving import DepthViews, carve
 from capnav.mapping.corroborate import corroborated
+from capnav.mapping.label_fit import LabelFitConfig, fitting_label
 from capnav.mapping.lifting import LiftedDetection
 from capnav.mapping.objects import MapObject, Observation
 from capnav.mapping.support import stands_on
@@ -90,6 +91,8 @@ class MemoryConfig:
     recheck_min_points: int = 50
     same_overlap: float = 0.95
     pool_unconfirmed: bool = True
+    #: the leading label ruled out by the object's size gives way to a runner-up it allows
+    label_fit: LabelFitConfig = field(default_factory=LabelFitConfig)
     max_dormant: int = 512  # buffers of dead unconfirmed tracks kept (the oldest go first): bounded on long recordings
     seed: int = 0
 
@@ -154,6 +157,7 @@ class ObjectMemory:
         self.relinks = 0  # detections moved to another object by the recheck
         self.weak_confirmed = 0  # tracks confirmed by the weak-candidate rule (``_confirms``)
         self.shape_confirmed = 0  # of those, confirmed without a confident sighting by their shape
+        self.relabelled: list[str] = []  # labels changed at export by the object's size (``label_fit``)
         self._rng = np.random.default_rng(self.config.seed)
 
     # ---- per frame ----------------------------------------------------------------------
@@ -476,6 +480,7 @@ class ObjectMemory:
     def export(self) -> list[MapObject]:
         """``MapObject``s in id order, renumbered 1..n; objects with too few points are dropped."""
         out: list[MapObject] = []
+        self.relabelled = []
         for obj in sorted(self.objects.values(), key=lambda o: o.id):
             if len(obj.points) < self.config.min_points:
                 continue
@@ -485,6 +490,10 @@ class ObjectMemory:
     def _to_map_object(self, obj: _ObjectState, new_id: int) -> MapObject:
         lo, hi, fp = object_box(obj.points, self.config.extent_percentile)
         label = obj.label
+        fitted, why = fitting_label(obj.votes or obj.weak_votes, obj.points, self.config.label_fit)
+        if fitted is not None:
+            label = fitted
+            self.relabelled.append(f"object {new_id}: {why}")
         cat = BY_NAME.get(label)
         mo = MapObject(
             id=new_id, label=label, label_votes=dict(sorted((obj.votes or obj.weak_votes).items())),

@@ -33,12 +33,14 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
+from capnav.core.categories import BY_NAME
 from capnav.core.errors import FrameError, InputError
 from capnav.core.frame import Frame
 from capnav.core.lazy import lazy_module
 from capnav.core.progress import track
 from capnav.io.dataset import DatasetReader
 from capnav.mapping.cmap import CameraTrajectory, CapNavMap
+from capnav.mapping.label_fit import fitting_label
 from capnav.mapping.mapper import Mapper, MapperConfig
 from capnav.mapping.memory import labels_compatible, object_box
 from capnav.mapping.objects import MapObject
@@ -593,7 +595,9 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
             m.label_votes = {lb: o.label_votes.get(lb, 0.0) + n.label_votes.get(lb, 0.0)
                              for lb in sorted(set(o.label_votes) | set(n.label_votes))}
             m.label = max(m.label_votes, key=lambda lb: (m.label_votes[lb], lb)) if m.label_votes else o.label
-            m.category_id = o.category_id if m.label == o.label else n.category_id
+            m.label = fitting_label(m.label_votes, m.points)[0] or m.label  # the size rules one out (label_fit)
+            m.category_id = o.category_id if m.label == o.label else n.category_id if m.label == n.label \
+                else getattr(BY_NAME.get(m.label), "id", 0)
             m.history = [*c.history, {"recording": k, "event": "moved", "position": np.round(n.position, 3).tolist(),
                                       "from": np.round(o.position, 3).tolist(), "frame": int(n.last_frame),
                                       "frames_empty": int(ev.empty[q])}]
