@@ -35,11 +35,37 @@ class Negation(RankingConstraint):
             st.report(self.kind, i, Evidence(self.kind, CONTRADICTED, 0.0, f"it is what '{phrase}' excludes"))
         had_named = bool((st.weights[st.pool] >= 1.0).any())
         st.keep(np.array([int(i) not in neg for i in st.pool], dtype=bool))
+        self.share_room(st)
         if not len(st.pool) or (had_named and not (st.weights[st.pool] >= 1.0).any()):
             # "not the black stove, the other one" presumes another of that category: an
             # alternative category ("a fridge can serve as a washer") is no "other one".
             st.refuse(self.kind, f"every {q.category or 'candidate'} matches what the instruction excludes "
                                  f"({'; '.join(q.negations)})")
+
+    @staticmethod
+    def share_room(st: RankState) -> None:
+        """"not the red lamp in the lounge, the other one": a negation that tells its object apart by
+        an attribute and says the room it stands in puts the one asked for in that room too (the
+        contrast is the attribute), when the request says no room of its own and another candidate
+        of the named category stands there. A negation whose only distinction is the room ("the lamp
+        that isn't in the lounge") sends the answer elsewhere, as before."""
+        q, r = st.q, st.r
+        if q.room is not None or not len(st.pool):
+            return
+        for phrase in q.negations:
+            if negated_relation(phrase) is not None:
+                continue
+            try:
+                nq = parse_instruction(phrase)
+            except InputError:
+                continue
+            if nq.room is None or not (nq.colors or nq.materials or nq.shapes or nq.size_word):
+                continue
+            there = np.array([r.scene.rooms[int(i)] == nq.room for i in st.pool], dtype=bool)
+            if (there & (st.weights[st.pool] >= 1.0)).any():
+                st.keep(there)
+                st.notes.append(f"the {nq.room} of '{phrase}' is where the other one stands too")
+            return
 
     @staticmethod
     def _colour_names(st: RankState, nq: ParsedQuery, ref: np.ndarray) -> np.ndarray:
