@@ -55,3 +55,17 @@ def test_the_activity_reaches_the_furniture(emb, text, ok):
     q = parse_instruction(text, emb)
     assert q.purpose, q
     assert q.category in ok, q
+
+
+@pytest.mark.parametrize(("text", "activity"), [
+    ("where should the muddy jeans go to be cleaned", "get the muddy jeans cleaned"),
+    ("where do my football socks go to get washed", "get my football socks washed"),
+    ("where do the spoons go", "keep the spoons"),            # where a thing is kept, as before
+])
+def test_what_is_done_to_a_thing_is_the_activity_not_where_it_is_kept(text, activity):
+    assert find_activity(text) == activity
+
+
+def test_a_thing_that_goes_to_be_washed_reaches_the_washer(emb):
+    q = parse_instruction("where should the muddy jeans go to be cleaned", emb)
+    assert q.category == "washing machine", q

@@ -63,6 +63,9 @@ _KEPT = [
                r"\s+(?P<obj>.+)"),
     re.compile(r"\b(?:keeps?|holds?|stores?)\s+(?P<obj>(?:the|my|our|your|all)\s+.+)"),
 ]
+#: What is done to a thing after the verb of where it goes: "(go) to get washed", "to be dried",
+#: "to dry off" (a passive's participle, or the verb itself).
+_DONE_TO = re.compile(r"^\s+to\s+(?:(?P<passive>get|be)\s+)?(?P<verb>[a-z]+)(?P<tail>(?:\s+(?:up|off|out|down))?)\b")
 #: A light verb with its article ("have a", "take a quick"): the noun after it names the activity.
 _LIGHT_VERB = re.compile(r"^(?:have|take|get|grab|catch|go\s+for|do)\s+(?:a|an|some)\s+"
                          r"(?:(?:quick|little|short|long|good|proper|nice)\s+)?(?=\w)")
@@ -133,6 +136,14 @@ def find_activity(text: str) -> str | None:
             obj = _TAIL.sub("", m.group("obj")).strip(" ,?.!")
             # "where can the kids sit": people doing something, not a thing kept somewhere
             if obj and obj.split()[-1] not in _PLACEHOLDERS and obj.split()[-1] not in persons:
+                done = _DONE_TO.match(low[m.end():])
+                if done is not None:
+                    # "where do the wet towels go to get dried": what is done to the thing, not
+                    # where it is kept.
+                    verb, tail = done.group("verb"), _TAIL.sub("", done.group("tail")).strip(" ,?.!")
+                    if done.group("passive"):
+                        return " ".join(p for p in ("get", obj, verb, tail) if p)
+                    return " ".join(p for p in (verb, tail, obj) if p)
                 return f"keep {obj}"
     said = _construction_activity(low)
     if said is not None:
