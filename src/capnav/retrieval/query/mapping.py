@@ -80,6 +80,32 @@ _PROX_WORDS = {"closest": "closest", "nearest": "closest", "farthest": "farthest
 
 
 
+#: The comparatives of the distance superlatives ("nearer" of "nearest"), made from them.
+_PROX_COMPARATIVES = {w[:-3] + "er": w for w in _PROX_WORDS if " " not in w and w.endswith("est")}
+_CMP = "|".join(sorted(_PROX_COMPARATIVES, key=len, reverse=True))
+#: A choice among instances said with a comparative: "the nearer of the two sofas", "the closer
+#: one of the armchairs", "which lamp is farther away", "which of the beds is closer to me".
+_SUP = "|".join(sorted((w for w in _PROX_WORDS if " " not in w), key=len, reverse=True))
+_PARTITIVE = re.compile(rf"\bthe\s+(?P<c>{_CMP}|{_SUP})\s+(?:one\s+)?of\s+(?:the\s+|these\s+|those\s+|my\s+)?"
+                        r"(?:(?:two|three|four|both|\d+)\s+)?")
+_WHICH = re.compile(rf"\bwhich\b[^,;]*?\b(?:is|are|s)\s+(?P<c>{_CMP})\b")
+
+
+def _comparative_choice(head: str) -> str:
+    """``head`` with a choice among instances put as a superlative of the category: "the nearer
+    of the two sofas" and "the nearest of the sofas" are "the nearest sofas" (the partitive's
+    "of" is no landmark), "which lamp is farther" is "which lamp is farthest". A comparative
+    elsewhere stays ("move closer")."""
+    m = _PARTITIVE.search(head)
+    if m:
+        c = m.group("c")
+        return f"{head[:m.start()]}the {_PROX_COMPARATIVES.get(c, c)} {head[m.end():]}".strip()
+    m = _WHICH.search(head)
+    if m:
+        return head[:m.start("c")] + _PROX_COMPARATIVES[m.group("c")] + head[m.end("c"):]
+    return head
+
+
 def _landmark_proximity(q: ParsedQuery, head: str) -> str:
     """"the chair closest to the kitchen table", "the plant nearest the bathtub", "the armchair
     farthest from the lamp": an anchor with closest / farthest measured from it. Returns ``head``
@@ -745,6 +771,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
             q.room = ROOM_SYNONYMS[phrase]
             head = (head[:m.start()] + " " + head[m.end():]).strip()
             break
+    head = _comparative_choice(head)
     # Ordinal: "the second closest", "the 3rd biggest".
     m = re.search(r"\b(first|second|third|fourth|fifth|1st|2nd|3rd|4th|5th)\s+(?=(?:closest|nearest|farthest"
                   r"|furthest|most distant|biggest|largest|smallest|tiniest|tallest|widest|littlest|narrowest)\b)",
