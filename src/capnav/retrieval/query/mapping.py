@@ -33,6 +33,7 @@ from capnav.retrieval.query.tokens import (
     _COLOUR_OF,
     _COMMON_ADJECTIVES,
     _FILLER,
+    _FORM_MAP,
     _GROWTH,
     _GROWTH_TOKENS,
     _LEX,
@@ -722,6 +723,32 @@ def _described_place(q: ParsedQuery, head: str, best: str | None, alts: dict[str
     return new, dict(sorted(out.items(), key=lambda kv: -kv[1]))
 
 
+def _compound_kind(words: list[str], cat: str | None, span: tuple[int, int] | None, fuzzy: bool
+                   ) -> tuple[list[str], str | None, tuple[int, int] | None, bool]:
+    """"the wing-back chair", "a wingbacked chair": a compound modifier whose first part, said with
+    the object noun, is a form of a kind of the named category (WordNet's "wing chair", an
+    armchair) names that kind. The first part is the word before a hyphen, or the longest start
+    (four letters or more, leaving three or more) of a closed compound the lexicon does not know."""
+    if cat is None or span is None or span[0] == 0 or fuzzy:
+        return words, cat, span, fuzzy
+    prev, noun = words[span[0] - 1], " ".join(words[span[0]:span[1]])
+    if "-" in prev:
+        parts = [prev.split("-", 1)[0]]
+    elif prev in _FORM_MAP or _knows(prev) or not prev.isalpha():
+        parts = []
+    else:
+        parts = [prev[:n] for n in range(len(prev) - 3, 3, -1)]
+    kinds = _LEX.relations.get(cat, {})
+    for part in parts:
+        kind = _FORM_MAP.get(f"{part} {noun}")
+        if kind is not None and kind != cat and kinds.get(kind, {}).get("kind_of"):
+            new = [*words[:span[0] - 1], part, *words[span[0]:]]
+            c2, s2, f2 = _find_category(new)
+            if c2 == kind:
+                return new, c2, s2, f2
+    return words, cat, span, fuzzy
+
+
 def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     """Read ``text``. With ``embedder`` (the retriever's), a request by purpose ("somewhere to
     sit") is mapped to categories through the lexicon's glosses; without one it keeps ``purpose``
@@ -860,6 +887,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
         q.shapes = list(dict.fromkeys([*q.shapes, "L-shaped"]))
     q.materials = materials_in(whole)
     cat, span, fuzzy = _find_category(words)
+    words, cat, span, fuzzy = _compound_kind(words, cat, span, fuzzy)
     # A word that is a material only as a noun ("plush": lavish as an adjective; "oak": a colour
     # before a noun) is one when said in a phrase after the target's noun ("the armchair covered
     # in soft plush", "made from solid oak"), not before it.
