@@ -29,3 +29,18 @@ def test_the_first_part_with_the_noun_names_a_kind(text, category):
 ])
 def test_other_compounds_leave_the_category(text, category):
     assert parse_instruction(text).category == category
+
+
+@pytest.mark.parametrize(("text", "category"), [
+    ("the wingback in the lounge", "armchair"),
+    ("could you go to the wingback please", "armchair"),
+])
+def test_a_closed_compound_said_alone_names_the_kind_its_start_names(text, category):
+    # "wingback": its start is the first word of one two-word form only (WordNet's "wing chair").
+    assert parse_instruction(text).category == category
+
+
+@pytest.mark.parametrize("text", ["the doohickey", "where's the thingamajig",
+                                  "wandering over to the thing on the left"])
+def test_an_unknown_word_with_no_such_start_names_nothing(text):
+    assert parse_instruction(text).category is None

@@ -723,12 +723,43 @@ def _described_place(q: ParsedQuery, head: str, best: str | None, alts: dict[str
     return new, dict(sorted(out.items(), key=lambda kv: -kv[1]))
 
 
+#: Two-word forms by their first word ("wing" -> ["wing chair"]).
+_FORMS_BY_FIRST: dict[str, list[str]] = {}
+for _form in _FORM_MAP:
+    _parts = _form.split()
+    if len(_parts) == 2 and _parts[0].isalpha():
+        _FORMS_BY_FIRST.setdefault(_parts[0], []).append(_form)
+
+
+def _closed_compound_alone(words: list[str], cat: str | None, span: tuple[int, int] | None, fuzzy: bool
+                           ) -> tuple[list[str], str | None, tuple[int, int] | None, bool]:
+    """"the wingback": a word no table knows, eight letters or more and no verb's inflection
+    (-ing, -ed), whose longest start of four letters or more (leaving four: a second word, not a
+    suffix) is the first word of two-word forms of one category only (WordNet's "wing chair")
+    names that category, read as that form."""
+    for k, w in enumerate(words):
+        if len(w) < 8 or not w.isalpha() or w.endswith(("ing", "ed")) or w in _FORM_MAP or _knows(w) \
+                or w in _FILLER:
+            continue
+        for n in range(len(w) - 4, 3, -1):
+            forms = _FORMS_BY_FIRST.get(w[:n], [])
+            if forms and len({_FORM_MAP[f] for f in forms}) == 1:
+                new = [*words[:k], *sorted(forms)[0].split(), *words[k + 1:]]
+                c2, s2, f2 = _find_category(new)
+                if c2 is not None:
+                    return new, c2, s2, f2
+                break
+    return words, cat, span, fuzzy
+
+
 def _compound_kind(words: list[str], cat: str | None, span: tuple[int, int] | None, fuzzy: bool
                    ) -> tuple[list[str], str | None, tuple[int, int] | None, bool]:
     """"the wing-back chair", "a wingbacked chair": a compound modifier whose first part, said with
     the object noun, is a form of a kind of the named category (WordNet's "wing chair", an
     armchair) names that kind. The first part is the word before a hyphen, or the longest start
     (four letters or more, leaving three or more) of a closed compound the lexicon does not know."""
+    if cat is None and span is None:
+        return _closed_compound_alone(words, cat, span, fuzzy)
     if cat is None or span is None or span[0] == 0 or fuzzy:
         return words, cat, span, fuzzy
     prev, noun = words[span[0] - 1], " ".join(words[span[0]:span[1]])
