@@ -827,6 +827,9 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
         m = next((m for m in re.finditer(pat, head) if not _form_follows(head, m.end())), None)
         if m:
             q.room = ROOM_SYNONYMS[phrase]
+            # "the yellow bedroom": a colour among the room's own modifiers tells rooms apart.
+            said = re.sub(rf"^(?:{preps})\s+(?:the\s+|my\s+|our\s+)?", "", m.group(0))
+            q.room_colors = _colors(said[: len(said) - len(phrase)].split())
             head = (head[:m.start()] + " " + head[m.end():]).strip()
             break
     head = _comparative_choice(head)
