@@ -69,3 +69,20 @@ def test_what_is_done_to_a_thing_is_the_activity_not_where_it_is_kept(text, acti
 def test_a_thing_that_goes_to_be_washed_reaches_the_washer(emb):
     q = parse_instruction("where should the muddy jeans go to be cleaned", emb)
     assert q.category == "washing machine", q
+
+
+SEATS = {"chair", "armchair", "sofa", "stool", "ottoman"}
+
+
+@pytest.mark.parametrize(("text", "ok"), [
+    ("somewhere to sit with my cup of tea", SEATS),
+    ("a place where I can sit down with the crossword", SEATS),
+    ("somewhere I can lie down with a good book", {"bed"}),
+    ("where can I write with my favourite pen", {"desk"}),
+])
+def test_what_the_act_is_done_with_does_not_choose_the_furniture(emb, text, ok):
+    # The comitative "with NP" says what accompanies the act ("coffee" drew the coffee table's
+    # definition, "where coffee is served"); the act says the furniture.
+    q = parse_instruction(text, emb)
+    assert q.purpose, q
+    assert q.category in ok, q

@@ -780,6 +780,18 @@ def _compound_kind(words: list[str], cat: str | None, span: tuple[int, int] | No
     return words, cat, span, fuzzy
 
 
+#: What an act is done with, after it: "sit [with my cup of tea]", "lie down [with a book]".
+_COMPANY = re.compile(r"\s+with\s+(?:my|a|an|the|some|our|your|his|her|their|this|that)\b.*$")
+
+
+def _without_company(act: str) -> str:
+    """The act without what it is done with ("sit with my morning coffee" -> "sit"): the act says
+    the furniture; what accompanies it would draw a category whose definition names that thing
+    (a coffee table's "where coffee is served")."""
+    bare = _COMPANY.sub("", act).strip()
+    return bare or act
+
+
 def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     """Read ``text``. With ``embedder`` (the retriever's), a request by purpose ("somewhere to
     sit") is mapped to categories through the lexicon's glosses; without one it keeps ``purpose``
@@ -984,7 +996,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                 # The retriever embeds the instruction next: one batch for both.
                 # The act says the furniture; what it is done for ("before making tea") the room.
                 parts = split_activity(activity) or [activity]
-                act = _without_modifying_categories(parts[0])
+                act = _without_company(_without_modifying_categories(parts[0]))
                 # What it is done for says the room: embedded in the same run.
                 match = match_purpose(act, embedder, along=(q.text, *(room_text(p) for p in parts[1:])))
                 best, alts = purpose_categories(match)
