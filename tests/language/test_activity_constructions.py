@@ -86,3 +86,19 @@ def test_what_the_act_is_done_with_does_not_choose_the_furniture(emb, text, ok):
     q = parse_instruction(text, emb)
     assert q.purpose, q
     assert q.category in ok, q
+
+
+@pytest.mark.parametrize(("text", "activity"), [
+    ("is there anything cold to drink", "drink anything cold"),
+    ("I want something soft to sit on", "sit on something soft"),
+    ("something to sit on", "sit on"),                         # no word said of the thing
+])
+def test_a_word_said_of_the_thing_goes_with_the_act(text, activity):
+    # "something cold to drink": "cold" is said of the thing drunk, which the act handles (the
+    # place's own adjective, "somewhere comfy to sit", stays the place's: ``place_adjective``).
+    assert find_activity(text) == activity
+
+
+def test_a_cold_drink_is_kept_in_the_fridge(emb):
+    q = parse_instruction("I'm parched, is there anything cold to drink", emb)
+    assert q.category == "refrigerator", q

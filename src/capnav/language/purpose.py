@@ -148,6 +148,12 @@ def find_activity(text: str) -> str | None:
     said = _construction_activity(low)
     if said is not None:
         return said
+    m = _THING_SAID.search(low)
+    if m and m.group("adj") not in _PLACEHOLDERS:
+        # "anything cold to drink": the word is said of the thing the act handles.
+        act = _TAIL.sub("", m.group("act")).strip(" ,?.!")
+        if act:
+            return f"{act} {m.group('thing')} {m.group('adj')}"
     for pat in _PURPOSE:
         m = pat.search(low)
         if m:
@@ -160,6 +166,9 @@ def find_activity(text: str) -> str | None:
     return None
 
 
+#: A thing with a word said of it before its use: "something cold to drink", "anything soft to sit on".
+_THING_SAID = re.compile(r"\b(?P<thing>something|anything)\s+(?P<adj>(?!to\b|for\b|where\b|that\b|which\b|i\b|we\b)"
+                         r"[a-z]+)\s+(?:to|for)\s+(?P<act>.+)$")
 #: A task one has (got) to do: "I've got to V ...", "we have got NP to V ...", "I have NP to V".
 _GOT = re.compile(r"\b(?:i|we)\s*(?:'ve|\s+have|\s+has)?\s+got\s+(?P<rest>.+)"
                   r"|\b(?:i|we)\s*(?:'ve|\s+have)\s+(?P<np_rest>(?:a|an|some|the|my|our|loads|lots|a\s+lot)\b.+)")
