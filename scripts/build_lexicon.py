@@ -236,10 +236,12 @@ def build(wordnet: Path) -> dict[str, Any]:
         out["room_glosses"] = _room_glosses(wn)
         out["gloss_adjectives"] = _gloss_adjectives(wn, out)
         out["furniture_senses"] = _furniture_senses(wn, out["forms"])
+        _irregular_plurals(out["forms"], out["growth"], noun_exc)
         out["plant_names"] = _plant_names(wn, out)
         names = set(out["plant_names"])
         out["other"] = [f for f in out["other"] if f not in names]  # "rubber plant" is one
         out["forms"] = dict(sorted(out["forms"].items()))
+        out["growth"] = dict(sorted(out["growth"].items()))
         return out
 
 
@@ -1354,6 +1356,37 @@ def _not_typos(wn: Any, forms: dict[str, str]) -> list[str]:
             if any(OSA.distance(form, t) <= typo_distance(form) for t in close) and _seen(wn, lemma):
                 out.add(form)
     return sorted(out)
+
+
+def _regular_plural(word: str) -> str:
+    """The plural the runtime makes of a form (``retrieval.query.tokens._plural``)."""
+    if word.endswith("f"):
+        return word[:-1] + "ves"
+    if word.endswith(("s", "x", "ch", "sh")):
+        return word + "es"
+    if word.endswith("y") and word[-2:-1] not in "aeiou":
+        return word[:-1] + "ies"
+    return word + "s"
+
+
+def _irregular_plurals(forms: dict[str, str], growth: dict[str, str], exceptions: list[str]) -> None:
+    """Add to ``forms`` (and to ``growth``) the plurals WordNet's exception list (``noun.exc``)
+    gives for the last word of a form where the runtime's regular plural differs: "cacti" is a
+    plant, and slender like a cactus. A plural that is already a form of its own stays as it is."""
+    plural_of: dict[str, list[str]] = {}
+    for line in exceptions:
+        parts = line.split()
+        if len(parts) >= 2 and parts[0].isalpha() and parts[1].isalpha():
+            plural_of.setdefault(parts[1], []).append(parts[0])
+    for form, cat in sorted(forms.items()):
+        *head, last = form.split()
+        for plural in plural_of.get(last, []):
+            if plural == _regular_plural(last):
+                continue
+            pform = " ".join([*head, plural])
+            forms.setdefault(pform, cat)
+            if form in growth and forms.get(pform) == cat:
+                growth.setdefault(pform, growth[form])
 
 
 def _persons(wn: Any, exceptions: list[str]) -> list[str]:

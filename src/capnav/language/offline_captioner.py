@@ -79,8 +79,10 @@ def footprint_shape(obj: MapObject, cfg: OfflineCaptionConfig) -> str | None:
 #: leather's), or a plain one (velvet, plastic, paint).
 SURFACE_WORDS = {"woven": "fabric", "grainy": "grainy", "plain": "smooth"}
 
-#: Categories that grow (foliage over a pot).
+#: Categories that grow (foliage over a pot): told apart by the pot's colour, the foliage being
+#: alike (the negation of a colour reads it so too: ``retrieval.constraints.negation``).
 _GROWING = {"plant"}
+GROWING = frozenset(_GROWING)
 
 #: Categories whose colour is their top's: a lamp is called by its shade ("the white lamp" with a
 #: grey pole and foot), so the stand's colour, the same on every lamp, does not make them alike.

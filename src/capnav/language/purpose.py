@@ -63,6 +63,9 @@ _KEPT = [
                r"\s+(?P<obj>.+)"),
     re.compile(r"\b(?:keeps?|holds?|stores?)\s+(?P<obj>(?:the|my|our|your|all)\s+.+)"),
 ]
+#: What is done to a thing after the verb of where it goes: "(go) to get washed", "to be dried",
+#: "to dry off" (a passive's participle, or the verb itself).
+_DONE_TO = re.compile(r"^\s+to\s+(?:(?P<passive>get|be)\s+)?(?P<verb>[a-z]+)(?P<tail>(?:\s+(?:up|off|out|down))?)\b")
 #: A light verb with its article ("have a", "take a quick"): the noun after it names the activity.
 _LIGHT_VERB = re.compile(r"^(?:have|take|get|grab|catch|go\s+for|do)\s+(?:a|an|some)\s+"
                          r"(?:(?:quick|little|short|long|good|proper|nice)\s+)?(?=\w)")
@@ -133,7 +136,24 @@ def find_activity(text: str) -> str | None:
             obj = _TAIL.sub("", m.group("obj")).strip(" ,?.!")
             # "where can the kids sit": people doing something, not a thing kept somewhere
             if obj and obj.split()[-1] not in _PLACEHOLDERS and obj.split()[-1] not in persons:
+                done = _DONE_TO.match(low[m.end():])
+                if done is not None:
+                    # "where do the wet towels go to get dried": what is done to the thing, not
+                    # where it is kept.
+                    verb, tail = done.group("verb"), _TAIL.sub("", done.group("tail")).strip(" ,?.!")
+                    if done.group("passive"):
+                        return " ".join(p for p in ("get", obj, verb, tail) if p)
+                    return " ".join(p for p in (verb, tail, obj) if p)
                 return f"keep {obj}"
+    said = _construction_activity(low)
+    if said is not None:
+        return said
+    m = _THING_SAID.search(low)
+    if m and m.group("adj") not in _PLACEHOLDERS:
+        # "anything cold to drink": the word is said of the thing the act handles.
+        act = _TAIL.sub("", m.group("act")).strip(" ,?.!")
+        if act:
+            return f"{act} {m.group('thing')} {m.group('adj')}"
     for pat in _PURPOSE:
         m = pat.search(low)
         if m:
@@ -143,6 +163,56 @@ def find_activity(text: str) -> str | None:
             if act and act not in _PLACEHOLDERS:
                 return _with_antecedent(act, low[: m.start()])
 
+    return None
+
+
+#: A thing with a word said of it before its use: "something cold to drink", "anything soft to sit on".
+_THING_SAID = re.compile(r"\b(?P<thing>something|anything)\s+(?P<adj>(?!to\b|for\b|where\b|that\b|which\b|i\b|we\b)"
+                         r"[a-z]+)\s+(?:to|for)\s+(?P<act>.+)$")
+#: A task one has (got) to do: "I've got to V ...", "we have got NP to V ...", "I have NP to V".
+_GOT = re.compile(r"\b(?:i|we)\s*(?:'ve|\s+have|\s+has)?\s+got\s+(?P<rest>.+)"
+                  r"|\b(?:i|we)\s*(?:'ve|\s+have)\s+(?P<np_rest>(?:a|an|some|the|my|our|loads|lots|a\s+lot)\b.+)")
+#: The thing before "to V": a noun phrase, then the verb and what follows it.
+_NP_TO_V = re.compile(r"^(?P<np>.+?)\s+to\s+(?P<verb>[a-z]+)\b(?P<tail>.*)$")
+#: A causative "get NP done" / "get NP written": the participle says the act done to the thing.
+_GET_DONE = re.compile(r"\bwhere\s+(?:can|could|do|should|might|would|may)\s+(?:i|we|one|you)\s+get\s+"
+                       r"(?P<np>(?:the|my|our|your|some|this|these|that|those|a|an)\s+.+?)\s+"
+                       r"(?P<part>done|[a-z]+(?:ed|en))\b(?P<tail>.*)$")
+#: A question about someone in the act: "where is SUBJ V-ing ..." (the copula may have gone with
+#: the reader's "'s": "where everyone having lunch").
+_PROGRESSIVE = re.compile(r"\bwhere(?:'s|\s+is|\s+are|\s+was|\s+were|\s+will)?\s+(?:be\s+)?"
+                          r"(?P<subj>(?:[a-z']+\s+){0,2}?[a-z']+)\s+(?P<act>[a-z]+ing\b.*)$")
+
+
+def _construction_activity(low: str) -> str | None:
+    """The activity of a task said as had or got to do ("I've got a pile of ironing to do" -> "do
+    a pile of ironing"), a thing got done ("where can I get my accounts done" -> "do my accounts")
+    or someone asked about in the act ("where are the kids eating" -> "eating"). Its subject or
+    object naming a category the map knows ("where's the lamp standing") is a thing, no act."""
+    forms = load_lexicon().forms
+    m = _GOT.search(low)
+    if m:
+        rest = (m.group("rest") or m.group("np_rest") or "").strip(" ,?.!")
+        if rest.startswith("to "):
+            act = rest[3:].strip()
+            return _TAIL.sub("", act).strip(" ,?.!") or None
+        n = _NP_TO_V.match(rest)
+        if n:
+            tail = _TAIL.sub("", n.group("tail")).strip(" ,?.!")
+            return " ".join(p for p in (n.group("verb"), n.group("np").strip(), tail) if p)
+        return None
+    m = _GET_DONE.search(low)
+    if m:
+        part = "do" if m.group("part") == "done" else m.group("part")
+        tail = _TAIL.sub("", m.group("tail")).strip(" ,?.!")
+        return " ".join(p for p in (part, m.group("np"), tail) if p)
+    m = _PROGRESSIVE.search(low)
+    if m:
+        subj = m.group("subj").split()
+        if any(" ".join(subj[i:j]) in forms for i in range(len(subj)) for j in range(i + 1, len(subj) + 1)):
+            return None
+        act = _TAIL.sub("", m.group("act")).strip(" ,?.!")
+        return act or None
     return None
 
 

@@ -273,19 +273,22 @@ class OfflineVerifier(Verifier):
             return True, 1.0, f"'{name}' matches '{noun}' (similarity {sim:.2f})"
         return False, 0.0, f"it is {a(name)}, not {a(noun)} (similarity {sim:.2f})"
 
-    def color(self, q: ParsedQuery, obj: MapObject, words: list[str] | None = None) -> tuple[float, str]:
+    def color(self, q: ParsedQuery, obj: MapObject, words: list[str] | None = None,
+              base: bool | None = None) -> tuple[float, str]:
         """Agreement in (0, 1] of the spoken colours (``words`` or the query's) with the object's
         observed colours (its base's for "the plant in the blue pot"); 0 and "" when none spoken.
         A shade the word covers (``colors.family``: royal blue for "blue", mustard for "yellow")
         counts at ``shade_weight`` (a lighter shade of a hue, light blue for "blue", at half that),
         so the colour itself or a dark shade of it (navy, ``colors.term_agreement``) ranks first."""
-        rank, _, why = self.color_fit(q, obj, words)
+        rank, _, why = self.color_fit(q, obj, words, base)
         return rank, why
 
-    def observed_colors(self, q: ParsedQuery, obj: MapObject) -> list[ColorCluster]:
+    def observed_colors(self, q: ParsedQuery, obj: MapObject, base: bool | None = None) -> list[ColorCluster]:
         """The colours a spoken colour is judged against: the pot's for "the plant in the blue
-        pot" when they were measured, else the object's ([] when none was measured)."""
-        cols = self.base_colors(obj) if re.search(r"\bpot\b", q.text.lower()) else []
+        pot" (or ``base``) when they were measured, else the object's ([] when none was measured)."""
+        if base is None:
+            base = re.search(r"\bpot\b", q.text.lower()) is not None
+        cols = self.base_colors(obj) if base else []
         return cols or self.colors(obj)
 
     def _own_name(self, word: str, c: ColorCluster) -> float:
@@ -294,7 +297,8 @@ class OfflineVerifier(Verifier):
         agree = term_agreement(word, c.lab)
         return max(agree, self.config.color_reject) if c.name == word else agree
 
-    def color_fit(self, q: ParsedQuery, obj: MapObject, words: list[str] | None = None) -> tuple[float, float, str]:
+    def color_fit(self, q: ParsedQuery, obj: MapObject, words: list[str] | None = None,
+                  base: bool | None = None) -> tuple[float, float, str]:
         """(ranking agreement, plausibility, why). The plausibility counts every shade the word
         covers in full: whether a person could call the object that colour at all ("the yellow
         lamp" of a mustard one), which is what a refusal must judge; the ranking agreement weighs
@@ -302,7 +306,7 @@ class OfflineVerifier(Verifier):
         words = q.colors if words is None else words
         if not words:
             return 0.0, 0.0, ""
-        cols = self.observed_colors(q, obj)
+        cols = self.observed_colors(q, obj, base)
         if not cols:
             return 0.0, 0.0, "its colour was not observed"
         floor = self.config.color_floor

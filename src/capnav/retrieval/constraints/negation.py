@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from capnav.core.errors import InputError
+from capnav.language.offline_captioner import GROWING
 from capnav.retrieval.constraints.base import CONTRADICTED, Evidence, RankingConstraint, RankState, ranking
 from capnav.retrieval.constraints.relation import BIN_M, landmark_instances
 from capnav.retrieval.query import ParsedQuery, parse_instruction
@@ -34,11 +35,58 @@ class Negation(RankingConstraint):
             st.report(self.kind, i, Evidence(self.kind, CONTRADICTED, 0.0, f"it is what '{phrase}' excludes"))
         had_named = bool((st.weights[st.pool] >= 1.0).any())
         st.keep(np.array([int(i) not in neg for i in st.pool], dtype=bool))
+        self.share_room(st)
         if not len(st.pool) or (had_named and not (st.weights[st.pool] >= 1.0).any()):
             # "not the black stove, the other one" presumes another of that category: an
             # alternative category ("a fridge can serve as a washer") is no "other one".
             st.refuse(self.kind, f"every {q.category or 'candidate'} matches what the instruction excludes "
                                  f"({'; '.join(q.negations)})")
+
+    @staticmethod
+    def share_room(st: RankState) -> None:
+        """"not the red lamp in the lounge, the other one": a negation that tells its object apart by
+        an attribute and says the room it stands in puts the one asked for in that room too (the
+        contrast is the attribute), when the request says no room of its own and another candidate
+        of the named category stands there. A negation whose only distinction is the room ("the lamp
+        that isn't in the lounge") sends the answer elsewhere, as before."""
+        q, r = st.q, st.r
+        if q.room is not None or not len(st.pool):
+            return
+        for phrase in q.negations:
+            if negated_relation(phrase) is not None:
+                continue
+            try:
+                nq = parse_instruction(phrase)
+            except InputError:
+                continue
+            if nq.room is None or not (nq.colors or nq.materials or nq.shapes or nq.size_word):
+                continue
+            there = np.array([r.scene.rooms[int(i)] == nq.room for i in st.pool], dtype=bool)
+            if (there & (st.weights[st.pool] >= 1.0)).any():
+                st.keep(there)
+                st.notes.append(f"the {nq.room} of '{phrase}' is where the other one stands too")
+            return
+
+    @staticmethod
+    def _colour_names(st: RankState, nq: ParsedQuery, ref: np.ndarray) -> np.ndarray:
+        """Which pool members a negated colour names. A growing category (a plant) is told apart by
+        its pot, its foliage being alike: there the colour is judged on the bases' colours when they
+        name some of ``ref`` but not all ("not the red one" among green-leaved plants is the one in
+        the red pot); otherwise, and for every other category, on the whole objects' colours."""
+        r, pool = st.r, st.pool
+
+        def names(base: bool | None) -> np.ndarray:
+            col = {int(i): r.judge.color(nq, r.objects[int(i)], base=base)[0] for i in pool}
+            best = max((col[int(i)] for i in ref), default=0.0)
+            bar = max(r.judge.config.color_reject, r.config.negation_contrast * best)
+            return np.array([col[int(i)] >= bar for i in pool], dtype=bool)
+
+        if st.q.category in GROWING:
+            in_ref = np.isin(pool, ref)
+            bases = names(True)
+            if 0 < int(bases[in_ref].sum()) < int(in_ref.sum()):
+                return bases
+        return names(None)
 
     @staticmethod
     def excluded(st: RankState) -> dict[int, str]:
@@ -84,10 +132,7 @@ class Negation(RankingConstraint):
                 fits &= r.cats_arr[pool] == nq.category
                 judged = True
             if nq.colors:
-                col = {int(i): r.judge.color(nq, r.objects[int(i)])[0] for i in pool}
-                best = max((col[int(i)] for i in ref), default=0.0)
-                bar = max(r.judge.config.color_reject, r.config.negation_contrast * best)
-                fits &= np.array([col[int(i)] >= bar for i in pool])
+                fits &= Negation._colour_names(st, nq, ref)
                 judged = True
             if nq.room is not None:
                 fits &= np.array([r.scene.rooms[int(i)] == nq.room for i in pool])

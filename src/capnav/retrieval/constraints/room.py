@@ -59,6 +59,10 @@ class Room(RankingConstraint):
             st.report(self.kind, int(i), Evidence(self.kind, status, float(strength[k]), seen))
         # Inferred room first, then objects of no inferred room, then the strength of the cues.
         st.group_keys.insert(0, -(2 * in_room + unknown))  # the room before the category tier
+        if q.room_colors and in_room.any():
+            coloured = self._coloured_room(st, room)
+            if coloured is not None:
+                st.group_keys.insert(1, -coloured)
         st.order_keys.append(-strength)
         st.values["room cue"] = strength
         st.predicate, st.mode = "room", "predicate"
@@ -92,6 +96,29 @@ class Room(RankingConstraint):
                                 + ", ".join(f"object {r.objects[i].id} ({r.scene.rooms[i] or 'a room of no type'})"
                                             for i in pool[away]))
                 st.keep(~away)
+
+    @staticmethod
+    def _coloured_room(st: RankState, room: str) -> np.ndarray | None:
+        """Per pool member, 1 when it stands in the one region of type ``room`` that holds the
+        object best fitting the room's colours ("the yellow bedroom": the yellow bed's), when that
+        fit is plausible and no other such region holds as good a one; else None (a note says so)."""
+        q, r, pool = st.q, st.r, st.pool
+        said = ParsedQuery(text=" ".join(q.room_colors), colors=list(q.room_colors))
+        best: dict[int, float] = {}
+        for k, obj in enumerate(r.objects):
+            g = int(r.scene.region[k])
+            if g < 0 or r.scene.region_rooms.get(g, (None, {}))[0] != room:
+                continue
+            best[g] = max(best.get(g, 0.0), r.judge.color_fit(said, obj)[1])
+        ranked = sorted(best.items(), key=lambda kv: -kv[1])
+        colour = "/".join(q.room_colors)
+        if not ranked or ranked[0][1] < r.judge.config.color_reject or (
+                len(ranked) > 1 and ranked[1][1] >= ranked[0][1] - 1e-6):
+            st.notes.append(f"no one {room} holds a {colour} object apart from the others; the colour was not used")
+            return None
+        region = ranked[0][0]
+        st.notes.append(f"the {colour} {room} is the one holding the {colour} object")
+        return np.array([int(r.scene.region[i]) == region for i in pool], dtype=np.float64)
 
     def _hallway(self, st: RankState) -> None:
         # A hallway has no characteristic objects: objects of a region without any room's cues

@@ -33,6 +33,7 @@ from capnav.retrieval.query.tokens import (
     _COLOUR_OF,
     _COMMON_ADJECTIVES,
     _FILLER,
+    _FORM_MAP,
     _GROWTH,
     _GROWTH_TOKENS,
     _LEX,
@@ -78,6 +79,32 @@ _PROX_WORDS = {"closest": "closest", "nearest": "closest", "farthest": "farthest
 
 
 
+
+
+#: The comparatives of the distance superlatives ("nearer" of "nearest"), made from them.
+_PROX_COMPARATIVES = {w[:-3] + "er": w for w in _PROX_WORDS if " " not in w and w.endswith("est")}
+_CMP = "|".join(sorted(_PROX_COMPARATIVES, key=len, reverse=True))
+#: A choice among instances said with a comparative: "the nearer of the two sofas", "the closer
+#: one of the armchairs", "which lamp is farther away", "which of the beds is closer to me".
+_SUP = "|".join(sorted((w for w in _PROX_WORDS if " " not in w), key=len, reverse=True))
+_PARTITIVE = re.compile(rf"\bthe\s+(?P<c>{_CMP}|{_SUP})\s+(?:one\s+)?of\s+(?:the\s+|these\s+|those\s+|my\s+)?"
+                        r"(?:(?:two|three|four|both|\d+)\s+)?")
+_WHICH = re.compile(rf"\bwhich\b[^,;]*?\b(?:is|are|s)\s+(?P<c>{_CMP})\b")
+
+
+def _comparative_choice(head: str) -> str:
+    """``head`` with a choice among instances put as a superlative of the category: "the nearer
+    of the two sofas" and "the nearest of the sofas" are "the nearest sofas" (the partitive's
+    "of" is no landmark), "which lamp is farther" is "which lamp is farthest". A comparative
+    elsewhere stays ("move closer")."""
+    m = _PARTITIVE.search(head)
+    if m:
+        c = m.group("c")
+        return f"{head[:m.start()]}the {_PROX_COMPARATIVES.get(c, c)} {head[m.end():]}".strip()
+    m = _WHICH.search(head)
+    if m:
+        return head[:m.start("c")] + _PROX_COMPARATIVES[m.group("c")] + head[m.end("c"):]
+    return head
 
 
 def _landmark_proximity(q: ParsedQuery, head: str) -> str:
@@ -696,6 +723,75 @@ def _described_place(q: ParsedQuery, head: str, best: str | None, alts: dict[str
     return new, dict(sorted(out.items(), key=lambda kv: -kv[1]))
 
 
+#: Two-word forms by their first word ("wing" -> ["wing chair"]).
+_FORMS_BY_FIRST: dict[str, list[str]] = {}
+for _form in _FORM_MAP:
+    _parts = _form.split()
+    if len(_parts) == 2 and _parts[0].isalpha():
+        _FORMS_BY_FIRST.setdefault(_parts[0], []).append(_form)
+
+
+def _closed_compound_alone(words: list[str], cat: str | None, span: tuple[int, int] | None, fuzzy: bool
+                           ) -> tuple[list[str], str | None, tuple[int, int] | None, bool]:
+    """"the wingback": a word no table knows, eight letters or more and no verb's inflection
+    (-ing, -ed), whose longest start of four letters or more (leaving four: a second word, not a
+    suffix) is the first word of two-word forms of one category only (WordNet's "wing chair")
+    names that category, read as that form."""
+    for k, w in enumerate(words):
+        if len(w) < 8 or not w.isalpha() or w.endswith(("ing", "ed")) or w in _FORM_MAP or _knows(w) \
+                or w in _FILLER:
+            continue
+        for n in range(len(w) - 4, 3, -1):
+            forms = _FORMS_BY_FIRST.get(w[:n], [])
+            if forms and len({_FORM_MAP[f] for f in forms}) == 1:
+                new = [*words[:k], *sorted(forms)[0].split(), *words[k + 1:]]
+                c2, s2, f2 = _find_category(new)
+                if c2 is not None:
+                    return new, c2, s2, f2
+                break
+    return words, cat, span, fuzzy
+
+
+def _compound_kind(words: list[str], cat: str | None, span: tuple[int, int] | None, fuzzy: bool
+                   ) -> tuple[list[str], str | None, tuple[int, int] | None, bool]:
+    """"the wing-back chair", "a wingbacked chair": a compound modifier whose first part, said with
+    the object noun, is a form of a kind of the named category (WordNet's "wing chair", an
+    armchair) names that kind. The first part is the word before a hyphen, or the longest start
+    (four letters or more, leaving three or more) of a closed compound the lexicon does not know."""
+    if cat is None and span is None:
+        return _closed_compound_alone(words, cat, span, fuzzy)
+    if cat is None or span is None or span[0] == 0 or fuzzy:
+        return words, cat, span, fuzzy
+    prev, noun = words[span[0] - 1], " ".join(words[span[0]:span[1]])
+    if "-" in prev:
+        parts = [prev.split("-", 1)[0]]
+    elif prev in _FORM_MAP or _knows(prev) or not prev.isalpha():
+        parts = []
+    else:
+        parts = [prev[:n] for n in range(len(prev) - 3, 3, -1)]
+    kinds = _LEX.relations.get(cat, {})
+    for part in parts:
+        kind = _FORM_MAP.get(f"{part} {noun}")
+        if kind is not None and kind != cat and kinds.get(kind, {}).get("kind_of"):
+            new = [*words[:span[0] - 1], part, *words[span[0]:]]
+            c2, s2, f2 = _find_category(new)
+            if c2 == kind:
+                return new, c2, s2, f2
+    return words, cat, span, fuzzy
+
+
+#: What an act is done with, after it: "sit [with my cup of tea]", "lie down [with a book]".
+_COMPANY = re.compile(r"\s+with\s+(?:my|a|an|the|some|our|your|his|her|their|this|that)\b.*$")
+
+
+def _without_company(act: str) -> str:
+    """The act without what it is done with ("sit with my morning coffee" -> "sit"): the act says
+    the furniture; what accompanies it would draw a category whose definition names that thing
+    (a coffee table's "where coffee is served")."""
+    bare = _COMPANY.sub("", act).strip()
+    return bare or act
+
+
 def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
     """Read ``text``. With ``embedder`` (the retriever's), a request by purpose ("somewhere to
     sit") is mapped to categories through the lexicon's glosses; without one it keeps ``purpose``
@@ -743,8 +839,12 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
         m = next((m for m in re.finditer(pat, head) if not _form_follows(head, m.end())), None)
         if m:
             q.room = ROOM_SYNONYMS[phrase]
+            # "the yellow bedroom": a colour among the room's own modifiers tells rooms apart.
+            said = re.sub(rf"^(?:{preps})\s+(?:the\s+|my\s+|our\s+)?", "", m.group(0))
+            q.room_colors = _colors(said[: len(said) - len(phrase)].split())
             head = (head[:m.start()] + " " + head[m.end():]).strip()
             break
+    head = _comparative_choice(head)
     # Ordinal: "the second closest", "the 3rd biggest".
     m = re.search(r"\b(first|second|third|fourth|fifth|1st|2nd|3rd|4th|5th)\s+(?=(?:closest|nearest|farthest"
                   r"|furthest|most distant|biggest|largest|smallest|tiniest|tallest|widest|littlest|narrowest)\b)",
@@ -833,6 +933,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
         q.shapes = list(dict.fromkeys([*q.shapes, "L-shaped"]))
     q.materials = materials_in(whole)
     cat, span, fuzzy = _find_category(words)
+    words, cat, span, fuzzy = _compound_kind(words, cat, span, fuzzy)
     # A word that is a material only as a noun ("plush": lavish as an adjective; "oak": a colour
     # before a noun) is one when said in a phrase after the target's noun ("the armchair covered
     # in soft plush", "made from solid oak"), not before it.
@@ -895,7 +996,7 @@ def read_goal(text: str, embedder: TextEmbedder | None = None) -> ParsedQuery:
                 # The retriever embeds the instruction next: one batch for both.
                 # The act says the furniture; what it is done for ("before making tea") the room.
                 parts = split_activity(activity) or [activity]
-                act = _without_modifying_categories(parts[0])
+                act = _without_company(_without_modifying_categories(parts[0]))
                 # What it is done for says the room: embedded in the same run.
                 match = match_purpose(act, embedder, along=(q.text, *(room_text(p) for p in parts[1:])))
                 best, alts = purpose_categories(match)

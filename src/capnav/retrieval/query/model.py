@@ -34,6 +34,9 @@ class ParsedQuery:
     anchor_category: str | None = None
     anchor_phrase: str | None = None
     room: str | None = None
+    #: Colours said of the room ("the yellow bedroom"): of the rooms of that type, the one holding
+    #: an object of that colour; never the target's colours.
+    room_colors: list[str] = field(default_factory=list)
     unknown_words: list[str] = field(default_factory=list)
     #: Other categories the target words may denote, with a weight below 1 (a chair request may
     #: be served by an armchair or a stool, ranked below chairs; a purpose maps to several).
