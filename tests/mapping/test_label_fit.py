@@ -50,3 +50,15 @@ def test_a_runner_up_ruled_out_too_does_not_take_over() -> None:
 
 def test_switched_off() -> None:
     assert fitting_label({"chair": 0.68, "table": 0.13}, slab(1.9, 1.6, 0.75), LabelFitConfig(enabled=False))[0] is None
+
+
+def test_the_caption_names_the_label_the_size_allows() -> None:
+    from capnav.language.context import SceneContext
+    from capnav.language.offline_captioner import ObservationCaptioner
+    from language.synth import make_obj
+
+    o = make_obj(1, "table", (3.0, 2.0), (1.9, 1.6, 0.75), (150, 110, 70))
+    o.points = slab(1.9, 1.6, 0.75).astype(np.float32)
+    o.colors = np.full((len(o.points), 3), 140, dtype=np.uint8)
+    o.label_votes = {"chair": 0.68, "table": 0.13}
+    assert ObservationCaptioner().caption(o, SceneContext([o])).text.startswith("TABLE"), o.label_votes

@@ -23,6 +23,7 @@ from capnav.language.context import SceneContext, canonical_label, label_of
 from capnav.language.form import FormConfig, growth, outline
 from capnav.language.prompts import MAX_CAPTION_WORDS
 from capnav.language.surface import Surface, SurfaceConfig, surface_of
+from capnav.mapping.label_fit import fitting_label
 from capnav.mapping.objects import MapObject
 
 _COUNT = {2: "two", 3: "three", 4: "four", 5: "five", 6: "six", 7: "seven", 8: "eight"}
@@ -50,9 +51,12 @@ class OfflineCaptionConfig:
 
 
 def vote_label(obj: MapObject) -> str:
-    """Category by label votes (accumulated confidence), falling back to the current label."""
+    """Category by label votes (accumulated confidence), unless the object's size rules the leading
+    one out for a runner-up (``mapping.label_fit``, the rule the map's label follows), falling
+    back to the current label."""
     if obj.label_votes:
-        return canonical_label(max(sorted(obj.label_votes.items()), key=lambda kv: kv[1])[0])
+        fitted = fitting_label(obj.label_votes, obj.points)[0]
+        return canonical_label(fitted or max(sorted(obj.label_votes.items()), key=lambda kv: kv[1])[0])
     return label_of(obj)
 
 
@@ -92,8 +96,9 @@ _SHADED = {"lamp"}
 class ObservationCaptioner(Captioner):
     """Writes "NAME, one sentence" from the map's observations (no model, deterministic)."""
 
-    model_id = "offline-observation-v5"  # v2: surface, rectangular and growth words; v3: "leafy", not "bushy";
-    # v4: grainy / smooth surfaces; v5: a lamp's colour and surface are its shade's
+    model_id = "offline-observation-v6"  # v2: surface, rectangular and growth words; v3: "leafy", not "bushy";
+    # v4: grainy / smooth surfaces; v5: a lamp's colour and surface are its shade's; v6: the name the
+    # object's size allows (``mapping.label_fit``)
 
     def __init__(self, config: OfflineCaptionConfig | None = None) -> None:
         self.config = config or OfflineCaptionConfig()
