@@ -57,7 +57,7 @@ def test_the_lookalike_that_meets_the_relation_is_chosen() -> None:
 def test_a_loose_word_takes_a_near_miss_a_tight_one_refuses() -> None:
     objs = [
         make_obj(1, "bed", (1.5, 1.2), (1.6, 2.0, 0.5), (230, 230, 235)),
-        make_obj(2, "lamp", (1.5, 3.75), (0.3, 0.3, 1.5), (200, 40, 40)),  # 1.4 m from the bed
+        make_obj(2, "lamp", (1.5, 3.65), (0.3, 0.3, 1.5), (200, 40, 40)),  # 1.3 m from the bed
         make_obj(3, "wardrobe", (0.2, 5.8), (0.6, 1.2, 2.0), (120, 80, 50)),
     ]
     r = offline_retriever(objs, two_rooms())
@@ -66,3 +66,6 @@ def test_a_loose_word_takes_a_near_miss_a_tight_one_refuses() -> None:
     assert loose.unmet is not None  # still said: farther than "next to"
     tight = r.query("go to the lamp right beside the bed")
     assert not tight.found and tight.unmet_candidate is not None and tight.unmet_candidate.id == 2, tight.reason
+    objs[1] = make_obj(2, "lamp", (1.5, 3.85), (0.3, 0.3, 1.5), (200, 40, 40))  # 1.5 m: near it no more
+    far = offline_retriever(objs, two_rooms()).query("go to the lamp near the bed")
+    assert not far.found and "the nearest is 1.5 m away" in far.reason, far.reason

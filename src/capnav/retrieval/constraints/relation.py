@@ -19,9 +19,11 @@ from capnav.retrieval.spatial import end_distance, has_long_axis, segment_distan
 BIN_M = 0.25  # distances closer than this are a tie on the relation
 #: Relations of nearness to a landmark, met within the captions' "next to" (``next_to_distance``).
 NEAR_RELATIONS = ("next to", "close to", "beside", "besides", "near", "by")
-#: A relation word looser than "next to" reaches this many times its distance before a request is
-#: refused for it: "the lamp near the bed" 1.4 m off is the lamp meant, "right beside" it is not.
-LOOSE_REACH = {"near": 1.5}
+#: How much farther than "next to" a looser word of nearness reaches before a request is refused
+#: for it (m): one bin of the order, the gap at which two candidates tie on the relation. "The lamp
+#: near the bed" 1.3 m off is the lamp meant, "right beside" it is not; 1.5 m off is near neither
+#: (the instruction generator's lookalikes stand a metre farther from the landmark than the target).
+LOOSE_REACH = {"near": BIN_M}
 #: Relations that put the target and the landmark in one room (walls between refuse them).
 _SAME_ROOM_RELATIONS = {"next to", "close to", "beside", "besides", "near", "by", "alongside", "against",
                         "on top of", "above", "below", "underneath", "beneath", "under", "atop", "on"}
@@ -179,7 +181,7 @@ class Relation(RankingConstraint):
                 # the captions' "next to" is said (``unmet``); farther than the word's reach (a loose
                 # "near" reaches farther) is recorded, and when every candidate is, the query refuses.
                 lim = float(r.scene.config.next_to_distance)
-                reach = lim * LOOSE_REACH.get(q.relation, 1.0)
+                reach = lim + LOOSE_REACH.get(q.relation, 0.0)
                 for i, g in zip(pool.tolist(), gap.tolist(), strict=True):
                     if lim < g < math.inf:
                         st.unmet[int(i)] = (f"it stands {g:.1f} m from the nearest {q.anchor_category}, not "
