@@ -94,3 +94,28 @@ def test_hidden_objects_are_described_where_visit_two_put_them() -> None:
     out = table(res)
     assert "| capnav-update-search | - | - | - | - | 100.0 (3) |" in out
     assert "capnav-update-search (hidden): reached within 3x: 2 of 3" in out
+
+
+def test_a_removed_description_fits_nothing_present_at_visit_two() -> None:
+    """A removed object is described as at visit 1; when an object of the same make stands in
+    visit 2 (here: a twin set down where it stood), every description of it also fits the twin, so
+    "not found" would be ill-posed: such episodes are described again from both visits' homes or,
+    as here where nothing tells the two apart, dropped and counted."""
+    cfg = ChangeTrackConfig(scenes=1, changes=ChangeSpec(moved=1, removed=1, added=1), per_class=4)
+    sc = SimConfig(layout=LayoutConfig(rooms=3), camera=CameraConfig(width=64, height=48))
+    with Simulator.from_seed(2, sc) as s1, Simulator.from_seed(2, sc, visit=2, changes=cfg.changes) as s2:
+        nav = s2.navigable()
+        truth = SceneTruth.from_manifest(s2.manifest, nav.spec, nav.cells == FREE)
+        m1, m2 = s1.manifest, s2.manifest
+        plain: dict[str, int] = {}
+        eps = _episodes(2, cfg, m1, m2, truth, plain)
+        (gone,) = [c.id for c in m2.changes if c.kind == "removed"]
+        top = max(o.id for o in [*m1.objects, *m2.objects])
+        twin = m1.object(gone).model_copy(update={"id": top + 1})
+        m2t = m2.model_copy(update={"objects": [*m2.objects, twin]})
+        counts: dict[str, int] = {}
+        eps_t = _episodes(2, cfg, m1, m2t, truth, counts)
+    assert len(eps["removed"]) == 4 and plain["removed_ill_posed"] == 0
+    assert eps_t["removed"] == [], [ep.subgoals[0].text for ep in eps_t["removed"]]
+    assert counts["removed_ill_posed"] == counts["removed_dropped"] > 0 and counts["removed_redescribed"] == 0
+    assert [ep.subgoals[0].text for ep in eps_t["moved"]] == [ep.subgoals[0].text for ep in eps["moved"]]

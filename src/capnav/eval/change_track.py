@@ -91,11 +91,22 @@ def _record(scene: int, cfg: ChangeTrackConfig, folder: Path) -> tuple[Path, Pat
     return v1, v2
 
 
-def _episodes(scene: int, cfg: ChangeTrackConfig, m1: Any, m2: Any, truth: SceneTruth) -> dict[str, list[Episode]]:
+def _episodes(scene: int, cfg: ChangeTrackConfig, m1: Any, m2: Any, truth: SceneTruth,
+              counts: dict[str, int] | None = None) -> dict[str, list[Episode]]:
+    """Per change class, ``cfg.per_class`` one-subgoal episodes. A removed object is described as
+    at visit 1, and the description must fit nothing present at visit 2 either (a newcomer of the
+    same make in another room also fits "the purple lounge chair": "not found" would be ill-posed):
+    it must single the object out in both visits' homes together (``_both_homes``). One that does
+    not is described again from those (another rng, so the other episodes stay as they were) or
+    dropped; ``counts`` (when given) receives ``removed_ill_posed``, ``removed_redescribed`` and
+    ``removed_dropped``."""
     from capnav.sim.instructions import InstructionGenerator
 
     rng = np.random.default_rng([cfg.seed, scene, 0xC4A6])
     gen1, gen2 = InstructionGenerator(m1), InstructionGenerator(m2)
+    both = _both_homes(m1, m2)
+    gen_both = InstructionGenerator(both)
+    tally = {"removed_ill_posed": 0, "removed_redescribed": 0, "removed_dropped": 0}
     changed = {c.id: c.kind for c in m2.changes}
     pools = {cls: [i for i, k in changed.items() if k == cls] for cls in CLASSES if cls != "unchanged"}
     pools["unchanged"] = sorted(o.id for o in m2.objects if o.id not in changed)
@@ -112,19 +123,37 @@ def _episodes(scene: int, cfg: ChangeTrackConfig, m1: Any, m2: Any, truth: Scene
             tried += 1
             start = truth.sample_start(rng)
             said = _single_out(gen, man, i, None if cls == "removed" else (start.x, start.y), rng)
+            if said is not None and cls == "removed" and not gen_both.singles_out(said):
+                tally["removed_ill_posed"] += 1
+                again = np.random.default_rng([cfg.seed, scene, 0xC4A7, tried])
+                said = _single_out(gen_both, both, i, None, again)
+                tally["removed_redescribed" if said is not None else "removed_dropped"] += 1
             if said is None:
                 continue
-            text, kind = said
+            text, kind = said.text, said.kind
             cat = next(o.category for o in man.objects if o.id == i)
             eps.append(Episode(id=f"s{scene}-{cls}-{len(eps)}", scene_seed=scene, start=start,
                                subgoals=[Subgoal(text=text, category=cat, kind=kind,
                                                  target_ids=[] if cls == "removed" else [i])]))
         out[cls] = eps
+    if counts is not None:
+        counts.update(tally)
     return out
 
 
+def _both_homes(m1: Any, m2: Any) -> Any:
+    """Visit 1's home with every object visit 2 holds elsewhere or anew beside it (a moved one at
+    both places, its second place under a fresh id): a description that singles an object out here
+    fits nothing either visit shows in its stead."""
+    old = {o.id: o for o in m1.objects}
+    extra = [o for o in m2.objects if o.id not in old or o.footprint != old[o.id].footprint]
+    top = max([o.id for o in m1.objects] + [o.id for o in m2.objects], default=0)
+    extra = [o if o.id not in old else o.model_copy(update={"id": top + 1 + k}) for k, o in enumerate(extra)]
+    return m1.model_copy(update={"objects": [*m1.objects, *extra]})
+
+
 def _single_out(gen: Any, man: Any, i: int, start_xy: tuple[float, float] | None, rng: np.random.Generator,
-                tries: int = 8) -> tuple[str, str] | None:
+                tries: int = 8) -> Any:
     """A description of object ``i`` that names it alone in ``man``'s home: the generator falls back
     to the bare kind ("the chair") when nothing else singles an object out, and with other chairs
     about that names any of them, which scores nothing about the change (a removed chair's "the
@@ -132,9 +161,9 @@ def _single_out(gen: Any, man: Any, i: int, start_xy: tuple[float, float] | None
     cat = next(o.category for o in man.objects if o.id == i)
     unique = sum(o.category == cat for o in man.objects) == 1
     for _ in range(tries):
-        text, kind = gen.describe(i, start_xy, rng)
-        if kind != "category" or unique:
-            return text, kind
+        ins = gen.describe_instruction(i, start_xy, rng)
+        if ins.kind != "category" or unique:
+            return ins
     return None
 
 
@@ -209,7 +238,8 @@ def run_change_scene(scene: int, cfg: ChangeTrackConfig, out: Path, progress: bo
         nav = sim.navigable()
         truth = SceneTruth.from_manifest(sim.manifest, nav.spec, nav.cells == FREE,
                                          sight=sight_grid(sim.apartment, nav.spec))
-        episodes = _episodes(scene, cfg, man1, man2, truth)
+        counts: dict[str, int] = {}
+        episodes = _episodes(scene, cfg, man1, man2, truth, counts)
         for name, cmap, frames in (("capnav", mu, r2), ("capnav-static", m1, r1), ("capnav-remap", mr, r2),
                                    ("capnav-search", m1, r1), ("capnav-update-search", mu, r2)):
             classes = SEARCH_CLASSES.get(name, CLASSES)
@@ -229,7 +259,7 @@ def run_change_scene(scene: int, cfg: ChangeTrackConfig, out: Path, progress: bo
                         records.append(r)
                         write_json(out / "logs" / name / cls / f"{ep.id}.json",
                                    {"episode": ep.model_dump(), "subgoal": r.to_dict()})
-    return {"scene_seed": scene, "records": [r.to_dict() for r in records], "timings": timings,
+    return {"scene_seed": scene, "records": [r.to_dict() for r in records], "timings": timings, "episodes": counts,
             "update": update_report, "objects": {"visit1": len(m1.objects), "updated": len(mu.objects),
                                                  "retired": len(mu.retired), "remapped": len(mr.objects)}}
 
@@ -267,7 +297,11 @@ def run_change_track(cfg: ChangeTrackConfig, out: Path, progress: bool = True) -
     results = {"track": "change", "changes": str(cfg.changes), "seed": cfg.seed, "scenes": cfg.scene_seeds(),
                "camera": [cfg.width, cfg.height], "detector": f"sim:{cfg.noise}", "summaries": summaries,
                "search": search, **({"update_search": _search_figures(hidden)} if hidden else {}),
-               "cpu_seconds": cpu, "per_scene": [{k: v for k, v in s.items() if k != "records"} for s in scenes]}
+               "cpu_seconds": cpu,
+               # removed-class descriptions that a visit-2 object also fits: described again or dropped
+               "episodes": {k: sum(s.get("episodes", {}).get(k, 0) for s in scenes)
+                            for k in ("removed_ill_posed", "removed_redescribed", "removed_dropped")},
+               "per_scene": [{k: v for k, v in s.items() if k != "records"} for s in scenes]}
     write_json(out / "results.json", results)
     return results
 

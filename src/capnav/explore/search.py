@@ -200,9 +200,12 @@ class ObjectSearch:
         self._start = ex.xy
         self.live.kinds = _kinds(self._parsed)
         q = first if first is not None else self.retriever.query(instruction, robot_xy=self._start)
-        self._first = q.chosen if q.found else None
+        # A refusal for a relation of nearness no saved candidate meets keeps the best of them: it is
+        # driven to and looked at like any saved answer (it may have been seen badly, or moved).
+        self._first = q.chosen if q.found else q.unmet_candidate
         if self._first is not None:
-            self._log("map", f"the map has it: object {self._first.id} ({self._first.caption or self._first.label}) "
+            has = "has it" if q.found else "has it only beyond the relation"
+            self._log("map", f"the map {has}: object {self._first.id} ({self._first.caption or self._first.label}) "
                              f"at ({self._first.position[0]:.2f}, {self._first.position[1]:.2f}); {q.reason}",
                       _xy(self._first))
         else:
@@ -591,9 +594,11 @@ class ObjectSearch:
         r = Retriever(snap.cmap, self.embedder, None, self.retriever.config, time_aware=False)
         q = r.query(self._parsed, robot_xy=self._start)
         n = len(snap.seen_new)
-        if not q.found or q.chosen is None:
+        # Refused for a relation of nearness no candidate meets: the best of them is still the lead
+        # (held back as not what was asked when seen, driven to when saved), so the search goes on.
+        o = q.chosen if q.found else q.unmet_candidate
+        if o is None:
             return Answer("none", None, f"no answer ({q.reason})", n)
-        o = q.chosen
         what = f"object {o.id} ({o.caption or o.label}) at ({o.position[0]:.2f}, {o.position[1]:.2f})"
         missing = [c for c in (self._parsed.anchor_category, self._parsed.anchor2_category)
                    if c is not None and not len(r.of_category(c))]

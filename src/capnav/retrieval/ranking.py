@@ -64,6 +64,8 @@ class Ranking:
     refusal: str | None = None  # a reason to answer "not found" before verification
     refused_by: str | None = None  # the kind of constraint that refused
     unmet: dict[int, str] = field(default_factory=dict)  # per candidate: the relation it does not meet
+    out_of_reach: dict[int, float] = field(default_factory=dict)  # per candidate: its gap beyond the reach
+    reach: float | None = None  # that reach (m): farther than it, a candidate does not meet the relation
 
 
 def semantic_order(E: F32, s: NDArray[np.float32], pool: NDArray[np.intp], weights: NDArray[np.float64],

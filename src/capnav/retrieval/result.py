@@ -29,6 +29,10 @@ class QueryResult:
     #: Why the chosen object does not meet the request's relation ("next to" a landmark it stands
     #: 1.6 m from), None when it does or the request has none: the best there is, not what was asked.
     unmet: str | None = None
+    #: When the query refused because every candidate stands beyond the request's relation of
+    #: nearness (``found`` False, ``chosen`` None): the best of them, which ``unmet`` is about. A
+    #: robot's search starts from it; ``capnav query --json`` gives it as ``unmet_candidate``.
+    unmet_candidate: MapObject | None = None
 
     def runners_up(self) -> list[dict[str, Any]]:
         out = []
@@ -51,6 +55,7 @@ class QueryResult:
             "distance_m": None if self.distance_m is None else round(self.distance_m, 4),
             "reason": self.reason,
             "unmet": self.unmet,
+            "unmet_candidate": obj(self.unmet_candidate) if self.unmet_candidate is not None else None,
             "terms": self.terms,
             "runners_up": self.runners_up(),
             "timings": {k: round(v, 6) for k, v in self.timings.items()},

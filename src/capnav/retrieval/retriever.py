@@ -217,6 +217,12 @@ class Retriever:
                     and s[chosen_i] < cfg.min_score:
                 verdict_reason = f"best similarity {s[chosen_i]:.2f} is below the threshold {cfg.min_score:.2f}"
                 chosen_i = None
+        miss_i = self._out_of_reach(rk, chosen_i)
+        if miss_i is not None:  # every candidate stands beyond the relation's reach: not what was asked
+            chosen_i = None
+            what = q.category or q.target_phrase or "such object"
+            verdict_reason = (f"no {what} stands {q.relation} {a(q.anchor_category or 'landmark')}: the nearest is "
+                              f"{min(rk.out_of_reach.values()):.1f} m away (within {rk.reach:.1f} m)")
         t3 = time.perf_counter()
         timings = {"embed": t1 - t0, "rank": t2 - t1, "verify": t3 - t2}
         runners = self._runners_up(rk, s, judged, chosen_i)
@@ -230,9 +236,14 @@ class Retriever:
             dist = float(d[chosen_i])
         reason = self._explain(q, chosen_i, s, rk, notes, verdict_reason, dist, verifier, runners, judged,
                                dist_kind)
-        unmet = rk.unmet.get(chosen_i) if chosen_i is not None else None
-        if unmet is not None:  # the best there is, not what was asked: said, so a user can judge it
+        said_of = chosen_i if miss_i is None else miss_i
+        unmet = rk.unmet.get(said_of) if said_of is not None else None
+        if unmet is not None and miss_i is None:  # within the word's reach, farther than "next to": said
             reason += f" It does not meet the request's relation: {unmet}."
+        elif miss_i is not None:  # refused; the best candidate is kept aside (a search looks on from it)
+            o = self.objects[miss_i]
+            reason = f"Not found: {verdict_reason}. The best candidate, object {o.id} ({o.caption or o.label}): " \
+                     f"{unmet}."
         return QueryResult(q.text, self.objects[chosen_i] if chosen_i is not None else None, chosen_i is not None,
                            float(s[chosen_i]) if chosen_i is not None else 0.0,
                            [(self.objects[i], sc) for i, sc, _, _ in runners], predicate, reason, timings,
@@ -240,7 +251,17 @@ class Retriever:
                            [{"terms": t, "why": w, "similarity": float(s[i]),
                              "verifier": judged[i].value if i in judged else None} for i, _, t, w in runners],
                            judged[chosen_i].terms if chosen_i in judged else {},
-                           judged[chosen_i].value if chosen_i in judged else None, unmet)
+                           judged[chosen_i].value if chosen_i in judged else None, unmet,
+                           self.objects[miss_i] if miss_i is not None else None)
+
+    @staticmethod
+    def _out_of_reach(rk: Ranking, chosen_i: int | None) -> int | None:
+        """The verifier's choice when every candidate stands beyond the request's relation of
+        nearness (its reach: "the easy chair beside the settee" with the only armchair 1.5 m from any
+        sofa), so the query refuses; None when one of them stands within it (or no relation)."""
+        if chosen_i is None or rk.reach is None or not len(rk.order):
+            return None
+        return chosen_i if all(int(i) in rk.out_of_reach for i in rk.order) else None
 
     def _about_time(self, instruction: str, robot_xy: tuple[float, float] | None
                     ) -> QueryResult | ParsedQuery | None:

@@ -264,6 +264,12 @@ class InstructionGenerator:
                  rng: np.random.Generator) -> tuple[str, str]:
         """The ``Describe`` callable of ``capnav.eval.generate``: a text that singles out
         ``instance_id`` and its kind; category only when nothing else does (or it is unique)."""
+        ins = self.describe_instruction(instance_id, robot_xy, rng)
+        return ins.text, ins.kind
+
+    def describe_instruction(self, instance_id: int, robot_xy: tuple[float, float] | None,
+                             rng: np.random.Generator) -> Instruction:
+        """``describe`` with what the text rests on (``Instruction.details``), for ``singles_out``."""
         o = self.by_id[instance_id]
         kinds = ["attribute", "superlative", "relation", "room"]
         if robot_xy is not None:
@@ -271,10 +277,30 @@ class InstructionGenerator:
         for k in rng.permutation(len(kinds)):
             ins = self.describe_as(o, kinds[int(k)], rng, robot_xy)
             if ins is not None:
-                return ins.text, ins.kind
+                return ins
         ins = self.describe_as(o, "category", rng)
         assert ins is not None
-        return ins.text, ins.kind
+        return ins
+
+    def singles_out(self, ins: Instruction) -> bool:
+        """Whether ``ins`` (made by this generator or by one of another home: another visit of
+        the apartment) names its instance alone in this home, by the rule of its kind: its colour
+        still differs from every lookalike's, it is still the biggest, its landmark still the only
+        one near, its room still the only one of that type with such an object, its kind unique."""
+        o = self.by_id.get(int(ins.details.get("instance", -1)))
+        if o is None:
+            return False
+        if ins.kind == "attribute":
+            return bool(self.peers(o)) and self.distinct_color(o)
+        if ins.kind == "superlative":
+            return self.superlative(o) == ins.details.get("superlative")
+        if ins.kind == "relation":
+            return bool(self.peers(o)) and self.relation_anchor(o) == ins.details.get("anchor")
+        if ins.kind == "room":
+            return bool(self.peers(o)) and self.unique_room(o) == ins.details.get("room")
+        if ins.kind == "closest":
+            return ins.robot_xy is not None and self.closest_ok(o, ins.robot_xy)
+        return not self.peers(o)  # a bare kind
 
     __call__ = describe
 

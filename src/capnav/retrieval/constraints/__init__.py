@@ -81,7 +81,7 @@ def rank(r: Candidates, q: ParsedQuery, s: NDArray[np.float32], robot_xy: tuple[
         if c.order >= SORT_AT:
             c.rank(st)
     return Ranking(st.order, st.groups, st.mode, st.predicate, st.weights, terms, st.refusal, st.refused_by,
-                   dict(st.unmet)), st
+                   dict(st.unmet), dict(st.out_of_reach), st.reach), st
 
 
 __all__ = ["ATTRIBUTES", "CONTRADICTED", "RANKING", "SUPPORTED", "UNOBSERVED", "AttributeConstraint", "Evidence",

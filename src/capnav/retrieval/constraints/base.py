@@ -72,6 +72,11 @@ class RankState:
     #: Per object index: why it does not stand where the request's relation puts it ("next to" a
     #: landmark farther than the captions' next-to distance); the order is not changed by it.
     unmet: dict[int, str] = field(default_factory=dict)
+    #: Per object index: its gap to the landmark when farther than the relation's reach (a loose
+    #: "near" reaches farther than "next to"); when every candidate is, the query refuses.
+    out_of_reach: dict[int, float] = field(default_factory=dict)
+    #: That reach (m), None without a relation of nearness.
+    reach: float | None = None
     order: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, np.intp))  # set by the sort
     groups: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, np.int64))
     #: Per constraint kind: per object index, the evidence it reported (for the explanation).

@@ -19,6 +19,11 @@ from capnav.retrieval.spatial import end_distance, has_long_axis, segment_distan
 BIN_M = 0.25  # distances closer than this are a tie on the relation
 #: Relations of nearness to a landmark, met within the captions' "next to" (``next_to_distance``).
 NEAR_RELATIONS = ("next to", "close to", "beside", "besides", "near", "by")
+#: How much farther than "next to" a looser word of nearness reaches before a request is refused
+#: for it (m): one bin of the order, the gap at which two candidates tie on the relation. "The lamp
+#: near the bed" 1.3 m off is the lamp meant, "right beside" it is not; 1.5 m off is near neither
+#: (the instruction generator's lookalikes stand a metre farther from the landmark than the target).
+LOOSE_REACH = {"near": BIN_M}
 #: Relations that put the target and the landmark in one room (walls between refuse them).
 _SAME_ROOM_RELATIONS = {"next to", "close to", "beside", "besides", "near", "by", "alongside", "against",
                         "on top of", "above", "below", "underneath", "beneath", "under", "atop", "on"}
@@ -171,13 +176,19 @@ class Relation(RankingConstraint):
             if q.relation in _SAME_ROOM_RELATIONS:
                 self._walls_between(st, anchors, gap)
             if q.relation in NEAR_RELATIONS:
-                # Ordered by the gap, the first is taken however far it is: the only plant left is
-                # "the plant beside the washer" three metres from any washer. Said, not refused.
+                # Ordered by the gap, the first would be taken however far it is: the only plant
+                # left as "the plant beside the washer" three metres from any washer. Farther than
+                # the captions' "next to" is said (``unmet``); farther than the word's reach (a loose
+                # "near" reaches farther) is recorded, and when every candidate is, the query refuses.
                 lim = float(r.scene.config.next_to_distance)
+                reach = lim + LOOSE_REACH.get(q.relation, 0.0)
                 for i, g in zip(pool.tolist(), gap.tolist(), strict=True):
                     if lim < g < math.inf:
                         st.unmet[int(i)] = (f"it stands {g:.1f} m from the nearest {q.anchor_category}, not "
                                             f"{q.relation} one (within {lim:.1f} m)")
+                    if reach < g < math.inf:
+                        st.out_of_reach[int(i)] = float(g)
+                st.reach = reach
         st.mode = "predicate"
 
     def _walls_between(self, st: RankState, anchors: NDArray[np.intp], gap: NDArray[np.float64]) -> None:
