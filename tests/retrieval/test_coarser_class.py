@@ -62,3 +62,12 @@ def test_no_kind_of_any_class_is_still_refused_for_that_reason(coco: Retriever) 
 def test_an_open_vocabulary_map_keeps_the_stand_in_rule(emb) -> None:
     res = _lounge(emb, {}).query("the armchair")
     assert not res.found, res.reason
+
+
+def test_a_table_at_dining_height_is_no_coffee_table(emb) -> None:
+    cmap = captioned_map([make_obj(1, "table", (2.0, 2.0), (1.6, 0.9, 0.76), (150, 100, 60)),
+                          make_obj(2, "chair", (3.5, 2.0), (0.45, 0.5, 0.9), (90, 90, 90))],
+                         emb, grid_with_wall(-0.5, -0.5, 9.0, 7.0))
+    cmap.meta.update(COCO)
+    res = Retriever(cmap, emb).query("the coffee table")
+    assert not res.found, res.reason

@@ -10,6 +10,7 @@ from capnav.core.text import agree, article, count, join, plural
 from capnav.language.context import canonical_label
 from capnav.language.lexicon import load_lexicon
 from capnav.retrieval.constraints.base import RankingConstraint, RankState, ranking
+from capnav.retrieval.constraints.detectable import coarser_classes, height_fits
 from capnav.retrieval.query import ParsedQuery
 
 
@@ -44,8 +45,13 @@ class Category(RankingConstraint):
             # A stand-in serves a named category only when the named word is its hypernym in the
             # lexicon (a coffee table is a table, an armchair a chair; a table is no desk, a chair
             # no stool, a sofa no bed). A purpose names several categories and is not restricted.
-            kinds = stand_ins(q)
-            keep = np.array([st.weights[i] >= 1.0 or r.cats[int(i)] in kinds for i in st.pool], dtype=bool)
+            coarse = coarser_classes(r.cmap, q.category)
+            kinds = stand_ins(q) | coarse
+            # What a coarser detector class holds is the category only at the category's height
+            # (a coffee table's top is 0.3-0.6 m: the dining table of a COCO map is none).
+            keep = np.array([st.weights[i] >= 1.0 or (r.cats[int(i)] in kinds and (
+                r.cats[int(i)] not in coarse or height_fits(r.objects[int(i)], q.category))) for i in st.pool],
+                dtype=bool)
             others = sorted({r.cats[int(i)] for i in st.pool[~keep]})
             st.keep(keep)
             if others:
@@ -53,7 +59,10 @@ class Category(RankingConstraint):
                                 f"{q.category} in the lexicon, so not considered")
         if at is not None:
             st.notes[at] = _count_note(st)
-        if st.named and q.purpose is None and cfg.use_type_filter and len(pool) and not (weights[pool] >= 1.0).any():
+        coarse = coarser_classes(r.cmap, q.category) if q.category is not None else set()
+        held = bool(coarse) and any(r.cats[int(i)] in coarse for i in st.pool)
+        if st.named and q.purpose is None and cfg.use_type_filter and len(pool) and not held \
+                and not (weights[pool] >= 1.0).any():
             # No instance of the named category: a kind of it serves only a request whose observed
             # attributes or landmark it shows ("the round wooden table" -> a round coffee table),
             # never a bare name ("the table" is not said of the only coffee table).

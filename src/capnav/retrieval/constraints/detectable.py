@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from capnav.core.text import plural
 from capnav.retrieval.constraints.base import RankingConstraint, RankState, ranking
 from capnav.retrieval.query import ParsedQuery
 
@@ -28,6 +29,32 @@ def detector_labels(meta: dict[str, Any]) -> frozenset[str] | None:
     return None
 
 
+def coarser_classes(cmap: Any, category: str) -> set[str]:
+    """The classes of the map's detector that ``category`` is a kind of, when it has no class of
+    its own (a COCO model's "chair" holds armchairs, its "dining table" coffee tables): where such
+    a map keeps the category's instances. Empty when the detector could name it, or when the map
+    does not say what its detector can name."""
+    labels = detector_labels(getattr(cmap, "meta", {}) or {})
+    if labels is None or category in labels:
+        return set()
+    from capnav.language.lexicon import load_lexicon
+
+    rel = load_lexicon().relations
+    return {p for p in labels if rel.get(p, {}).get(category, {}).get("kind_of")}
+
+
+def height_fits(obj: Any, category: str, tol: float = 0.1) -> bool:
+    """Whether the object's top is at ``category``'s working height (``corroborate.PRIORS``), or
+    the category has no such prior (nothing to contradict)."""
+    from capnav.mapping.corroborate import PRIORS
+
+    prior = PRIORS.get(category)
+    if prior is None:
+        return True
+    top = float(obj.extent_max[2])
+    return prior.z_lo - tol <= top <= prior.z_hi + tol
+
+
 @ranking
 class Detectable(RankingConstraint):
     kind = "detectable"
@@ -46,6 +73,12 @@ class Detectable(RankingConstraint):
         if labels is None or q.category in labels:
             return
         det = str(r.cmap.meta.get("detector", "the detector")).split(":")[0]
+        held = sorted(coarser_classes(r.cmap, q.category) & {r.cats[int(i)] for i in st.pool})
+        if held:
+            st.notes.append(f"the map's detector ({det}) has no '{q.category}' class: "
+                            f"{' and '.join(plural(h) for h in held)} are what it calls "
+                            f"{plural(q.category)}, so they are looked at")
+            return
         why = (f"the map's detector ({det}) has no '{q.category}' class, so the map cannot contain "
                f"{'an' if q.category[:1] in 'aeiou' else 'a'} {q.category}")
         # Refused unless a stand-in the request admits is in the map (a table for "the desk"): with
