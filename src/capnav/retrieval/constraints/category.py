@@ -10,7 +10,7 @@ from capnav.core.text import agree, article, count, join, plural
 from capnav.language.context import canonical_label
 from capnav.language.lexicon import load_lexicon
 from capnav.retrieval.constraints.base import RankingConstraint, RankState, ranking
-from capnav.retrieval.constraints.detectable import coarser_classes, height_fits
+from capnav.retrieval.constraints.classes import coarser_classes, height_fits
 from capnav.retrieval.query import ParsedQuery
 
 
