@@ -4,12 +4,14 @@ footprint rules it out and a runner-up label it also voted for does not.
 Issue 21: a real COCO detector scores a dining table low in every frame while the chairs around
 it score high, and their boxes hold pieces of the top; the object mapped there then carries
 "chair" (CenterNet on a simulated kitchen at 640x480: chair 0.68, table 0.13 over a 1.6 x 1.9 m
-top), and a sofa seen as a chair is a 2 m "chair". No chair is 1.9 m long, and the same
-sightings also said table (or sofa): that label is the one the object's size allows. Only a
-label with a footprint prior (``corroborate.PRIORS``: tables, coffee tables and chairs, from
-furniture standards) can be ruled out, and only by a clear margin (``slack``); a runner-up that
-holds ``min_share`` of the votes and that its own prior (if it has one) does not rule out takes
-its place. Reading the points only, never the scene's truth."""
+top). No chair is 1.4 m long, and the same sightings also said table: that label is the one
+the object's size allows. Only labels with a footprint prior (``corroborate.PRIORS``: tables,
+coffee tables and chairs, from furniture standards) take part: the leading one is ruled out only
+by a clear margin (``slack``), and a runner-up that holds ``min_share`` of the votes takes its
+place only when its own prior fits. A runner-up without a prior is no evidence from size: a new
+chair fused with a stool beside it (1.7 m) would become a "stool" (change track seed 100, scene
+100002), so a sofa seen as a 2 m "chair" stays a chair. Reading the points only, never the
+scene's truth."""
 
 from __future__ import annotations
 
@@ -55,7 +57,7 @@ def fitting_label(votes: Mapping[str, float], points: NDArray[np.floating],
         return None, ""
     total = sum(max(v, 0.0) for _, v in ranked)
     for label, v in ranked[1:]:
-        if total > 0 and v / total >= cfg.min_share and not ruled_out(label, short, long, cfg):
+        if total > 0 and v / total >= cfg.min_share and label in PRIORS and not ruled_out(label, short, long, cfg):
             return label, (f"a {lead} is never {long:.2f} x {short:.2f} m; its sightings also said "
                            f"{label} ({v / total:.0%} of the votes), which that size allows")
     return None, ""
