@@ -41,11 +41,12 @@ class Category(RankingConstraint):
             pool = np.arange(n)
             weights = np.ones(n)
         st.pool, st.weights = pool, weights
+        # The detector's classes the named category is kept under when it has no class of its own.
+        coarse = coarser_classes(r.cmap, q.category) if q.category is not None else set()
         if st.named and q.purpose is None and q.category is not None and cfg.use_type_filter and len(pool):
             # A stand-in serves a named category only when the named word is its hypernym in the
             # lexicon (a coffee table is a table, an armchair a chair; a table is no desk, a chair
             # no stool, a sofa no bed). A purpose names several categories and is not restricted.
-            coarse = coarser_classes(r.cmap, q.category)
             kinds = stand_ins(q) | coarse
             # What a coarser detector class holds is the category only at the category's height
             # (a coffee table's top is 0.3-0.6 m: the dining table of a COCO map is none).
@@ -59,7 +60,6 @@ class Category(RankingConstraint):
                                 f"{q.category} in the lexicon, so not considered")
         if at is not None:
             st.notes[at] = _count_note(st)
-        coarse = coarser_classes(r.cmap, q.category) if q.category is not None else set()
         held = bool(coarse) and any(r.cats[int(i)] in coarse for i in st.pool)
         if st.named and q.purpose is None and cfg.use_type_filter and len(pool) and not held \
                 and not (weights[pool] >= 1.0).any():
