@@ -80,6 +80,8 @@ GRAPH = {m: dict(imports(m)) for m in MODULES}
 
 def layer(module: str) -> str:
     parts = module.split(".")
+    if parts[1:] == ["__main__"]:
+        return "cli"  # ``python -m capnav`` is the command line
     return parts[1] if len(parts) > 1 else ""
 
 
