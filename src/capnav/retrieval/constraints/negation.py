@@ -13,6 +13,21 @@ from capnav.retrieval.query import ParsedQuery, parse_instruction
 from capnav.retrieval.query.mapping import negated_relation
 
 
+def readings(q: ParsedQuery) -> dict[str, ParsedQuery]:
+    """Each negated phrase read as a request of its own ("not the red lamp in the lounge": a red
+    lamp, in the lounge), once per query; a relation ("not beside the bed") or a phrase that does
+    not read is left out."""
+    out: dict[str, ParsedQuery] = {}
+    for phrase in q.negations:
+        if phrase in out or negated_relation(phrase) is not None:
+            continue
+        try:
+            out[phrase] = parse_instruction(phrase)
+        except InputError:
+            continue
+    return out
+
+
 @ranking
 class Negation(RankingConstraint):
     kind = "negation"
@@ -26,7 +41,8 @@ class Negation(RankingConstraint):
         if not len(st.pool):
             return
         q, r = st.q, st.r
-        neg = self.excluded(st)
+        read = readings(q)
+        neg = self.excluded(st, read)
         if not neg:
             return
         st.notes.append("excluded by the negation: " + ", ".join(
@@ -35,7 +51,7 @@ class Negation(RankingConstraint):
             st.report(self.kind, i, Evidence(self.kind, CONTRADICTED, 0.0, f"it is what '{phrase}' excludes"))
         had_named = bool((st.weights[st.pool] >= 1.0).any())
         st.keep(np.array([int(i) not in neg for i in st.pool], dtype=bool))
-        self.share_room(st)
+        self.share_room(st, read)
         if not len(st.pool) or (had_named and not (st.weights[st.pool] >= 1.0).any()):
             # "not the black stove, the other one" presumes another of that category: an
             # alternative category ("a fridge can serve as a washer") is no "other one".
@@ -43,7 +59,7 @@ class Negation(RankingConstraint):
                                  f"({'; '.join(q.negations)})")
 
     @staticmethod
-    def share_room(st: RankState) -> None:
+    def share_room(st: RankState, read: dict[str, ParsedQuery]) -> None:
         """"not the red lamp in the lounge, the other one": a negation that tells its object apart by
         an attribute and says the room it stands in puts the one asked for in that room too (the
         contrast is the attribute), when the request says no room of its own and another candidate
@@ -52,13 +68,7 @@ class Negation(RankingConstraint):
         q, r = st.q, st.r
         if q.room is not None or not len(st.pool):
             return
-        for phrase in q.negations:
-            if negated_relation(phrase) is not None:
-                continue
-            try:
-                nq = parse_instruction(phrase)
-            except InputError:
-                continue
+        for phrase, nq in read.items():
             if nq.room is None or not (nq.colors or nq.materials or nq.shapes or nq.size_word):
                 continue
             there = np.array([r.scene.rooms[int(i)] == nq.room for i in st.pool], dtype=bool)
@@ -89,8 +99,9 @@ class Negation(RankingConstraint):
         return names(None)
 
     @staticmethod
-    def excluded(st: RankState) -> dict[int, str]:
-        """Candidates of the pool a negation names, with the phrase.
+    def excluded(st: RankState, read: dict[str, ParsedQuery]) -> dict[int, str]:
+        """Candidates of the pool a negation names, with the phrase (``read``: the phrases' own
+        readings, ``readings``).
 
         A negated colour is read as a definite description among the candidates: it names the
         ones that fit it best (agreement at least ``color_reject``, and at least
@@ -115,9 +126,8 @@ class Negation(RankingConstraint):
                         for i in pool[g <= g.min() + BIN_M]:
                             out.setdefault(int(i), phrase)
                 continue
-            try:
-                nq = parse_instruction(phrase)
-            except InputError:
+            nq = read.get(phrase)
+            if nq is None:
                 continue
             if nq.category is not None and nq.category != q.category and not nq.colors and not nq.room:
                 if nq.category in q.category_alternatives and not nq.has_attributes:
