@@ -26,7 +26,7 @@ from typing import Any
 
 from capnav.eval.map_quality import QualityConfig, match_objects
 from capnav.mapping.cmap import CapNavMap
-from capnav.retrieval.constraints.detectable import detector_labels
+from capnav.retrieval.constraints.classes import detector_labels
 from capnav.sim.manifest import SceneManifest
 
 #: Outcomes that count as right, per change class.

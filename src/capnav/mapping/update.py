@@ -595,7 +595,7 @@ def update_map(cmap: CapNavMap, reader: DatasetReader, detector: Detector, encod
             m.label_votes = {lb: o.label_votes.get(lb, 0.0) + n.label_votes.get(lb, 0.0)
                              for lb in sorted(set(o.label_votes) | set(n.label_votes))}
             m.label = max(m.label_votes, key=lambda lb: (m.label_votes[lb], lb)) if m.label_votes else o.label
-            m.label = fitting_label(m.label_votes, m.points)[0] or m.label  # the size rules one out (label_fit)
+            m.label = fitting_label(m.label_votes, m.points, mapper.config.memory.label_fit)[0] or m.label  # label_fit
             m.category_id = o.category_id if m.label == o.label else n.category_id if m.label == n.label \
                 else getattr(BY_NAME.get(m.label), "id", 0)
             m.history = [*c.history, {"recording": k, "event": "moved", "position": np.round(n.position, 3).tolist(),
